@@ -1,0 +1,3 @@
+from roc.cli.main import main
+
+raise SystemExit(main())

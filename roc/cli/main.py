@@ -1,0 +1,89 @@
+"""The ``roc`` command: argument parsing, dispatch and the error convention.
+
+Exit codes: 0 ok, 1 failure, 2 usage error, 130 interrupted. Errors are one line on stderr; a Python
+traceback only with ``--debug`` or ``ROC_DEBUG=1``. Command modules are imported only when run, so
+that start-up stays light.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import sys
+
+from roc import __version__
+from roc.errors import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_USAGE, RocError
+
+# (command path, aliases, module in roc.commands, help)
+COMMANDS = (
+    (("work",), ("w",), None, "workspace: list, inspect and build packages"),
+    (("work", "list"), ("ls",), "work_list", "list the packages of the workspace (like colcon list)"),
+    (("work", "info"), (), "work_info", "show package details (like colcon info)"),
+    (("work", "graph"), (), "work_graph", "show the dependency graph (like colcon graph)"),
+    (("completion",), (), "completion", "print a shell completion script: bash, zsh or fish"),
+)
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with roc's one-line usage errors."""
+
+    def error(self, message: str):  # type: ignore[override]
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
+def build_parser() -> Parser:
+    parser = Parser(prog="roc", description="roc: fast, dependable tools for ROS 2 workspaces.")
+    parser.add_argument("--version", action="version", version=f"roc {__version__}")
+    parser.add_argument("--debug", action="store_true", help="show Python tracebacks for errors")
+    parser.add_argument("-C", dest="directory", metavar="DIR", help="run as if roc was started in DIR")
+    groups: dict[tuple[str, ...], argparse._SubParsersAction] = {
+        (): parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
+    }
+    for path, aliases, module, help_text in COMMANDS:
+        sub = groups[path[:-1]].add_parser(path[-1], aliases=list(aliases), help=help_text, description=help_text)
+        if module is None:
+            groups[path] = sub.add_subparsers(dest="_".join(path) + "_command", metavar="COMMAND", parser_class=Parser)
+            sub.set_defaults(_group=sub)
+        else:
+            _command_module(module).add_arguments(sub)
+            sub.set_defaults(_module=module, _group=None)
+    return parser
+
+
+def _command_module(name: str):
+    return importlib.import_module(f"roc.commands.{name}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    debug = os.environ.get("ROC_DEBUG") == "1" or "--debug" in (argv if argv is not None else sys.argv[1:])
+    try:
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        module = getattr(args, "_module", None)
+        if module is None:
+            (getattr(args, "_group", None) or parser).print_help(sys.stderr)
+            return EXIT_USAGE
+        if args.directory:
+            try:
+                os.chdir(args.directory)
+            except OSError as error:
+                raise RocError(f"-C {args.directory}: {error.strerror}") from None
+        return _command_module(module).run(args)
+    except RocError as error:
+        if debug:
+            raise
+        print(f"roc: error: {error}", file=sys.stderr)
+        return error.exit_code
+    except KeyboardInterrupt:
+        print("roc: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        # The reader went away (e.g. `roc work list | head`): not an error worth a message.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    except Exception as error:  # noqa: BLE001 - last resort: one line, details with --debug
+        if debug:
+            raise
+        print(f"roc: internal error: {type(error).__name__}: {error} (run with --debug for details)", file=sys.stderr)
+        return EXIT_FAILURE

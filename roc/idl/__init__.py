@@ -1,0 +1,1 @@
+"""Interface definition conversion (.proto <-> .msg)."""

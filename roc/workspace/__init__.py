@@ -1,0 +1,1 @@
+"""The workspace model: discovery, identification, manifests, dependency graph, selection."""

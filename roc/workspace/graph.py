@@ -1,0 +1,71 @@
+"""The dependency graph of a workspace: colcon's topological order and recursive dependencies.
+
+colcon orders packages in layers: every package whose dependencies are all placed is ready, and the
+ready ones are placed alphabetically, layer by layer. Layering by direct dependencies gives the same
+layers as colcon's layering by recursive ones (each recursive dependency is reached by a chain of
+direct ones), so the stdlib's ``graphlib`` does it without the cost of importing networkx.
+"""
+
+from __future__ import annotations
+
+from graphlib import CycleError, TopologicalSorter
+from typing import Iterable
+
+from roc.errors import RocError
+from roc.workspace.package import CATEGORIES, Package
+
+
+class DependencyCycleError(RocError):
+    pass
+
+
+def topological_order(packages: Iterable[Package]) -> list[Package]:
+    """Packages in colcon's flat topological order; raises DependencyCycleError on a cycle."""
+    by_name = {p.name: p for p in packages}
+    sorter = TopologicalSorter({name: p.direct_dependencies() & by_name.keys() for name, p in by_name.items()})
+    try:
+        sorter.prepare()
+    except CycleError as error:
+        raise _cycle_error(error.args[1], by_name) from None
+    ordered: list[Package] = []
+    while sorter.is_active():
+        ready = sorted(sorter.get_ready())
+        ordered.extend(by_name[name] for name in ready)
+        sorter.done(*ready)
+    return ordered
+
+
+def _cycle_error(cycle: list[str], by_name: dict[str, Package]) -> DependencyCycleError:
+    # graphlib lists each node before the node that depends on it; print "depends on" order.
+    chain = list(reversed(cycle))
+    steps = []
+    for package, dependency in zip(chain, chain[1:]):
+        categories = [c for c in CATEGORIES if dependency in by_name[package].dependencies.get(c, ())]
+        steps.append(f"{package} -[{','.join(categories)}]-> ")
+    where = ", ".join(f"{name} ({by_name[name].path})" for name in chain[:-1])
+    return DependencyCycleError(
+        f"dependency cycle: {''.join(steps)}{chain[-1]}; packages: {where}. "
+        "Remove one of these dependencies to break the cycle."
+    )
+
+
+def recursive_dependencies(
+    package: Package, by_name: dict[str, Package], recursive_categories: Iterable[str] | None = ("run",)
+) -> dict[str, int]:
+    """Workspace packages ``package`` depends on, with their depth (1 = direct), as colcon computes them:
+    direct dependencies of every category, then the ``recursive_categories`` of those, transitively."""
+    recursive_categories = tuple(recursive_categories or CATEGORIES)
+    depths: dict[str, int] = {}
+    level = package.direct_dependencies()
+    depth = 0
+    while level:
+        depth += 1
+        following: set[str] = set()
+        for name in sorted(level - depths.keys()):
+            dependency = by_name.get(name)
+            if dependency is None or name == package.name:
+                continue
+            depths[name] = depth
+            following |= dependency.direct_dependencies(recursive_categories)
+        level = following - depths.keys()
+    return depths

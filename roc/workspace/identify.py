@@ -1,0 +1,137 @@
+"""Decide whether a directory is a package, and of which type, with colcon's precedence:
+
+1. ``COLCON_IGNORE`` prunes the directory.
+2. ``colcon.pkg`` (JSON) may set the name and type and add dependencies, hooks and metadata.
+3. ``package.xml`` makes a ROS package (``AMENT_IGNORE``/``CATKIN_IGNORE`` prune; a ROS 1 ``manifest.xml``
+   without package.xml prunes too).
+4. Otherwise ``CMakeLists.txt`` makes a ``cmake`` package and ``setup.py`` a ``python`` one; a directory
+   that is both is ambiguous and pruned, as colcon does.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Mapping
+
+from roc.errors import ManifestError
+from roc.workspace.cmake_project import read_cmake_project
+from roc.workspace.manifest import parse_manifest
+from roc.workspace.package import CATEGORIES, Package
+from roc.workspace.python_setup import read_setup_cfg, read_setup_py, setup_cfg_is_sufficient
+
+IGNORE_MARKERS = ("COLCON_IGNORE", "AMENT_IGNORE", "CATKIN_IGNORE")
+
+
+class SkipLocation(Exception):
+    """This directory and everything below it is not to be crawled."""
+
+
+def warn(message: str) -> None:
+    print(f"roc: warning: {message}", file=sys.stderr)
+
+
+def identify(directory: Path, shown_path: Path, filenames: set[str], variables: Mapping[str, str]) -> Package | None:
+    """The package at ``directory`` (``filenames`` are its files), None if it is not one."""
+    if "COLCON_IGNORE" in filenames:
+        raise SkipLocation
+    config = _read_colcon_pkg(directory / "colcon.pkg") if "colcon.pkg" in filenames else {}
+    wanted_type = config.get("type")
+    package = None
+    if wanted_type is None or wanted_type.startswith("ros."):
+        package = _identify_ros(directory, shown_path, filenames, variables)
+    if package is None and (wanted_type is None or not wanted_type.startswith("ros.")):
+        package = _identify_build_system(directory, shown_path, filenames, wanted_type)
+    if package is None:
+        if wanted_type and config.get("name"):
+            package = Package(name=config["name"], path=shown_path, type=wanted_type)
+        else:
+            return None
+    _apply_colcon_pkg(package, config)
+    return package
+
+
+def _identify_ros(directory: Path, shown_path: Path, filenames: set[str], variables) -> Package | None:
+    if "AMENT_IGNORE" in filenames or "CATKIN_IGNORE" in filenames:
+        raise SkipLocation
+    if "package.xml" not in filenames:
+        if "manifest.xml" in filenames:  # a ROS 1 dry package: not to be mistaken for a CMake one
+            raise SkipLocation
+        return None
+    manifest = parse_manifest(directory / "package.xml", variables)
+    if manifest.build_type == "ament_python" and "setup.py" not in filenames:
+        warn(f"{shown_path}: ROS package '{manifest.name}' has build type ament_python but no setup.py; ignored")
+        raise SkipLocation
+    package = Package(name=manifest.name, path=shown_path, type=f"ros.{manifest.build_type}")
+    for category, dependencies in manifest.category_dependencies().items():
+        package.dependencies[category] = set(dependencies)
+        for name, dependency in dependencies.items():
+            if dependency.versions:
+                package.constraints.setdefault(name, {}).update(dependency.versions)
+    package.metadata["version"] = manifest.version
+    maintainers = [m for m in manifest.maintainers if m.endswith(">")]
+    if maintainers:
+        package.metadata["maintainers"] = maintainers
+    package.group_depends = manifest.group_depends
+    package.member_of_groups = manifest.member_of_groups
+    package.manifest = manifest
+    return package
+
+
+def _identify_build_system(directory: Path, shown_path: Path, filenames: set[str], wanted_type) -> Package | None:
+    found = []
+    if wanted_type in (None, "cmake") and "CMakeLists.txt" in filenames:
+        name, depends = read_cmake_project(directory / "CMakeLists.txt")
+        package = Package(name=name, path=shown_path, type="cmake")
+        package.dependencies.update(build=set(depends), run=set(depends))
+        found.append(package)
+    if wanted_type in (None, "python") and "setup.py" in filenames:
+        found.append(_identify_python(directory, shown_path, filenames))
+    if len(found) > 1:
+        warn(f"{shown_path}: both a CMake and a Python package; ignored (add a colcon.pkg that sets its type)")
+        raise SkipLocation
+    return found[0] if found else None
+
+
+def _identify_python(directory: Path, shown_path: Path, filenames: set[str]) -> Package:
+    setup_py = directory / "setup.py"
+    project = None
+    if "setup.cfg" in filenames and setup_cfg_is_sufficient(setup_py):
+        project = read_setup_cfg(directory / "setup.cfg")
+    if project is None:
+        project = read_setup_py(setup_py)
+    package = Package(name=project.name, path=shown_path, type="python")
+    for category in CATEGORIES:
+        package.dependencies[category] = set(project.dependencies.get(category, ()))
+    package.metadata["version"] = project.version  # None when unknown, as colcon shows it
+    if project.maintainers:
+        package.metadata["maintainers"] = project.maintainers
+    return package
+
+
+def _read_colcon_pkg(path: Path) -> dict:
+    try:
+        data = json.loads(path.read_text(encoding="utf-8") or "{}")
+    except json.JSONDecodeError as error:
+        raise ManifestError(str(path), f"invalid JSON: {error.msg}; colcon.pkg must be a JSON object", error.lineno)
+    except OSError as error:
+        raise ManifestError(str(path), f"cannot be read: {error.strerror or error}") from None
+    if not isinstance(data, dict):
+        raise ManifestError(str(path), "must hold a JSON object such as {\"name\": \"my_pkg\", \"type\": \"cmake\"}")
+    return data
+
+
+def _apply_colcon_pkg(package: Package, config: dict) -> None:
+    """Fold colcon.pkg into the package as colcon's ``update_descriptor`` does."""
+    if "name" in config:  # colcon.pkg wins over the name the build system gives
+        package.name = config["name"]
+    for category in CATEGORIES:
+        names = [*config.get("dependencies", ()), *config.get(f"{category}-dependencies", ())]
+        if names:
+            package.dependencies.setdefault(category, set()).update(names)
+    package.hooks.extend(config.get("hooks", ()))
+    reserved = {"name", "type", "dependencies", "hooks"} | {f"{c}-dependencies" for c in CATEGORIES}
+    for key, value in config.items():
+        if key not in reserved:
+            package.metadata[key] = value

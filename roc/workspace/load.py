@@ -1,0 +1,51 @@
+"""Turn the discovery and selection options of a command into the packages it works on."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from roc.workspace.conditions import condition_environment
+from roc.workspace.discovery import discover_packages
+from roc.workspace.graph import topological_order
+from roc.workspace.package import Package
+from roc.workspace.root import find_workspace_root
+from roc.workspace.selection import check_selection_arguments, ignore_packages, select_packages
+
+
+@dataclass
+class Workspace:
+    root: Path
+    ordered: list[Package]  # every package not ignored, in topological order
+    selected: set[str] = field(default_factory=set)
+
+    @property
+    def by_name(self) -> dict[str, Package]:
+        return {p.name: p for p in self.ordered}
+
+    def selected_in_order(self) -> list[Package]:
+        return [p for p in self.ordered if p.name in self.selected]
+
+
+def resolve_root(args: argparse.Namespace) -> Path:
+    """Explicit --base-paths/--paths are taken from the current directory, as colcon does; otherwise
+    roc looks upward for the workspace root and says so when it is not the current directory."""
+    cwd = Path.cwd()
+    if args.base_paths is not None or args.paths is not None:
+        return cwd
+    root = find_workspace_root(cwd) or cwd
+    if root != cwd:
+        print(f"roc: using workspace root {root}", file=sys.stderr)
+    return root
+
+
+def load_workspace(args: argparse.Namespace) -> Workspace:
+    root = resolve_root(args)
+    packages = discover_packages(root, condition_environment(os.environ), args.base_paths, args.paths)
+    check_selection_arguments(args, {p.name for p in packages})
+    ordered = topological_order(ignore_packages(args, packages))
+    build_base = root / getattr(args, "build_base", "build")
+    return Workspace(root=root, ordered=ordered, selected=select_packages(args, ordered, build_base))

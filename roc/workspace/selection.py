@@ -1,0 +1,184 @@
+"""Package selection with colcon's semantics, shared by every verb.
+
+``--packages-ignore*`` remove packages from the graph as if they did not exist; every other option
+only marks packages as skipped, so they stay in the graph (ordering, recursive dependencies).
+"""
+
+from __future__ import annotations
+
+import argparse
+import difflib
+import re
+from pathlib import Path
+from typing import Callable, Iterable
+
+from roc.errors import UsageError
+from roc.workspace.graph import recursive_dependencies
+from roc.workspace.identify import warn
+from roc.workspace.package import Package
+
+# Options that take package names, checked against the workspace.
+NAME_OPTIONS = (
+    "packages_up_to", "packages_above", "packages_above_and_dependencies", "packages_select_by_dep",
+    "packages_skip_by_dep", "packages_skip_up_to", "packages_select", "packages_skip", "packages_ignore",
+)
+REGEX_OPTIONS = ("packages_ignore_regex", "packages_up_to_regex", "packages_select_regex", "packages_skip_regex")
+INTERRUPTED_RESULT = "SIGINT"
+
+
+def add_selection_arguments(parser: argparse.ArgumentParser) -> None:
+    """Discovery and selection options, as in colcon (``--packages-start``/``-end`` spelled as colcon 0.21)."""
+    discovery = parser.add_argument_group("discovery")
+    discovery.add_argument("--base-paths", nargs="*", metavar="PATH",
+                           help="base paths to crawl recursively for packages (default: the workspace root)")
+    discovery.add_argument("--paths", nargs="*", metavar="PATH",
+                           help="package directories to use (shell wildcards allowed, e.g. 'src/*')")
+    discovery.add_argument("--packages-ignore", nargs="*", metavar="PKG_NAME",
+                           help="ignore packages as if they were not discovered")
+    discovery.add_argument("--packages-ignore-regex", nargs="*", metavar="PATTERN",
+                           help="ignore packages whose name matches any of the patterns")
+    group = parser.add_argument_group("package selection")
+    add = group.add_argument
+    add("--packages-up-to", nargs="*", metavar="PKG_NAME", help="only these packages and their recursive dependencies")
+    add("--packages-up-to-regex", nargs="*", metavar="PATTERN",
+        help="only packages matching a pattern and their recursive dependencies")
+    add("--packages-above", nargs="*", metavar="PKG_NAME",
+        help="only these packages and the packages that recursively depend on them")
+    add("--packages-above-and-dependencies", nargs="*", metavar="PKG_NAME",
+        help="as --packages-above, plus the recursive dependencies of all of those")
+    add("--packages-above-depth", nargs="+", metavar=("DEPTH", "PKG_NAME"),
+        help="as --packages-above, but only up to DEPTH levels of dependents")
+    add("--packages-select-by-dep", nargs="*", metavar="DEP_NAME",
+        help="only packages that (recursively) depend on any of these")
+    add("--packages-skip-by-dep", nargs="*", metavar="DEP_NAME",
+        help="skip packages that (recursively) depend on any of these")
+    add("--packages-skip-up-to", nargs="*", metavar="PKG_NAME", help="skip these packages and their recursive dependencies")
+    previous = group.add_mutually_exclusive_group()
+    previous.add_argument("--packages-select-build-failed", action="store_true",
+                          help="only packages whose last build failed (aborted ones are not failures)")
+    previous.add_argument("--packages-skip-build-finished", action="store_true",
+                          help="skip packages whose last build finished successfully")
+    add("--packages-select", nargs="*", metavar="PKG_NAME", help="only these packages")
+    add("--packages-skip", nargs="*", metavar="PKG_NAME", help="skip these packages")
+    add("--packages-select-regex", nargs="*", metavar="PATTERN", help="only packages whose name matches a pattern")
+    add("--packages-skip-regex", nargs="*", metavar="PATTERN", help="skip packages whose name matches a pattern")
+    add("--packages-start", metavar="PKG_NAME", help="skip packages before this one in topological order")
+    add("--packages-end", metavar="PKG_NAME", help="skip packages after this one in topological order")
+
+
+def _matches(patterns: Iterable[str] | None, name: str) -> bool:
+    return any(re.match(p, name) for p in patterns or ())
+
+
+def check_selection_arguments(args: argparse.Namespace, names: set[str]) -> None:
+    """Unknown package names and invalid patterns are usage errors that say what to do."""
+    depth_args = getattr(args, "packages_above_depth", None) or []
+    if depth_args:
+        if not depth_args[0].isdigit():
+            raise UsageError(f"--packages-above-depth: the first value must be a depth (0, 1, ...), not '{depth_args[0]}'")
+    checks = [(option, getattr(args, option, None) or []) for option in NAME_OPTIONS]
+    checks += [("packages_above_depth", depth_args[1:]), ("packages_start", [args.packages_start] if args.packages_start else []),
+               ("packages_end", [args.packages_end] if args.packages_end else [])]
+    for option, values in checks:
+        for name in values:
+            if name not in names:
+                close = difflib.get_close_matches(name, sorted(names), n=3)
+                hint = f"; did you mean {', '.join(close)}?" if close else "; run 'roc work list -n' to see the package names"
+                raise UsageError(f"--{option.replace('_', '-')}: no package named '{name}' in the workspace{hint}")
+    for option in REGEX_OPTIONS:
+        for pattern in getattr(args, option, None) or []:
+            try:
+                re.compile(pattern)
+            except re.error as error:
+                raise UsageError(f"--{option.replace('_', '-')}: invalid pattern '{pattern}': {error}") from None
+            if not any(re.match(pattern, n) for n in names):
+                warn(f"--{option.replace('_', '-')} '{pattern}' matches no package name")
+
+
+def ignore_packages(args: argparse.Namespace, packages: list[Package]) -> list[Package]:
+    ignored = set(getattr(args, "packages_ignore", None) or [])
+    patterns = getattr(args, "packages_ignore_regex", None)
+    return [p for p in packages if p.name not in ignored and not _matches(patterns, p.name)]
+
+
+def select_packages(args: argparse.Namespace, ordered: list[Package], build_base: Path | None = None) -> set[str]:
+    """Names of the packages to process; ``ordered`` is the full topological order."""
+    by_name = {p.name: p for p in ordered}
+    _recursive: dict[str, dict[str, int]] = {}
+
+    def deps_of(name: str) -> dict[str, int]:
+        if name not in _recursive:
+            _recursive[name] = recursive_dependencies(by_name[name], by_name)
+        return _recursive[name]
+
+    selected = set(by_name)
+
+    def up_to(roots: set[str]) -> set[str]:
+        keep = set(roots)
+        for package in reversed(ordered):
+            if package.name in keep:
+                keep |= deps_of(package.name).keys()
+        return keep
+
+    def above(roots: set[str]) -> set[str]:
+        return roots | {p.name for p in ordered if roots & deps_of(p.name).keys()}
+
+    if args.packages_up_to or args.packages_up_to_regex:
+        roots = set(args.packages_up_to or []) | {n for n in by_name if _matches(args.packages_up_to_regex, n)}
+        selected &= up_to(roots)
+    if args.packages_above:
+        selected &= above(set(args.packages_above))
+    if args.packages_above_and_dependencies:
+        selected &= up_to(above(set(args.packages_above_and_dependencies)))
+    if args.packages_above_depth and len(args.packages_above_depth) > 1:
+        depth = int(args.packages_above_depth[0])
+        roots = set(args.packages_above_depth[1:])
+        selected &= roots | {p.name for p in ordered
+                             if any(d in roots and level <= depth for d, level in deps_of(p.name).items())}
+    if args.packages_select_by_dep:
+        wanted = set(args.packages_select_by_dep)
+        selected &= {p.name for p in ordered if wanted & deps_of(p.name).keys()}
+    if args.packages_skip_by_dep:
+        unwanted = set(args.packages_skip_by_dep)
+        selected -= {p.name for p in ordered if unwanted & deps_of(p.name).keys()}
+    if args.packages_skip_up_to:
+        selected -= up_to(set(args.packages_skip_up_to))
+    if args.packages_select_build_failed or args.packages_skip_build_finished:
+        selected &= _by_previous_result(args, ordered, build_base or Path("build"))
+    if args.packages_select is not None or args.packages_select_regex is not None:
+        chosen = set(args.packages_select or [])
+        selected &= {n for n in by_name if n in chosen or _matches(args.packages_select_regex, n)}
+    skipped = set(args.packages_skip or [])
+    selected -= {n for n in by_name if n in skipped or _matches(args.packages_skip_regex, n)}
+    if args.packages_start or args.packages_end:
+        selected &= _in_range(args, ordered)
+    return selected
+
+
+def _in_range(args: argparse.Namespace, ordered: list[Package]) -> set[str]:
+    names = [p.name for p in ordered]
+    start = names.index(args.packages_start) if args.packages_start else 0
+    end = names.index(args.packages_end) if args.packages_end else len(names) - 1
+    if end < start:
+        raise UsageError(
+            f"--packages-end '{args.packages_end}' comes before --packages-start '{args.packages_start}' "
+            "in topological order; swap them"
+        )
+    return set(names[start:end + 1])
+
+
+def previous_build_result(build_base: Path, name: str) -> str | None:
+    """The result colcon (and roc) stored for the last build of ``name``: '0' for success."""
+    try:
+        return (build_base / name / "colcon_build.rc").read_text().strip()
+    except OSError:
+        return None
+
+
+def _by_previous_result(args: argparse.Namespace, ordered: list[Package], build_base: Path) -> set[str]:
+    keep: Callable[[str | None], bool]
+    if args.packages_select_build_failed:
+        keep = lambda result: result not in (None, "0", INTERRUPTED_RESULT)  # noqa: E731
+    else:
+        keep = lambda result: result != "0"  # noqa: E731
+    return {p.name for p in ordered if keep(previous_build_result(build_base, p.name))}
