@@ -21,6 +21,7 @@ COMMANDS = (
     (("work", "list"), ("ls",), "work_list", "list the packages of the workspace (like colcon list)"),
     (("work", "info"), (), "work_info", "show package details (like colcon info)"),
     (("work", "graph"), (), "work_graph", "show the dependency graph (like colcon graph)"),
+    (("work", "build"), ("b",), "work_build", "build the workspace (a drop-in for colcon build)"),
     (("completion",), (), "completion", "print a shell completion script: bash, zsh or fish"),
 )
 
@@ -59,6 +60,12 @@ def main(argv: list[str] | None = None) -> int:
     debug = os.environ.get("ROC_DEBUG") == "1" or "--debug" in (argv if argv is not None else sys.argv[1:])
     try:
         parser = build_parser()
+        argv = list(sys.argv[1:] if argv is None else argv)
+        if any(token in argv for token in ("--cmake-args", "--ament-cmake-args")):
+            from roc.commands.completion import all_options
+            from roc.commands.work_build import rewrite_passthrough
+
+            argv = rewrite_passthrough(argv, all_options(parser))
         args = parser.parse_args(argv)
         module = getattr(args, "_module", None)
         if module is None:

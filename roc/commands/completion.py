@@ -40,6 +40,11 @@ def command_tree(parser: argparse.ArgumentParser, path: tuple[str, ...] = ()) ->
     return tree
 
 
+def all_options(parser: argparse.ArgumentParser) -> set[str]:
+    """Every option string of every command."""
+    return {option for _, options, _ in command_tree(parser).values() for option in options}
+
+
 def _case_key(path: tuple[str, ...]) -> str:
     return " ".join(path)
 

@@ -50,10 +50,13 @@ def _cycle_error(cycle: list[str], by_name: dict[str, Package]) -> DependencyCyc
 
 
 def recursive_dependencies(
-    package: Package, by_name: dict[str, Package], recursive_categories: Iterable[str] | None = ("run",)
+    package: Package, by_name: dict[str, Package], recursive_categories: Iterable[str] | None = None
 ) -> dict[str, int]:
     """Workspace packages ``package`` depends on, with their depth (1 = direct), as colcon computes them:
-    direct dependencies of every category, then the ``recursive_categories`` of those, transitively."""
+    direct dependencies of every category, then the ``recursive_categories`` of those, transitively.
+
+    The default, every category, is what colcon 0.21 does: its verbs ask for ``run`` only, but that
+    request takes effect only under ``COLCON_FEATURE_FLAGS=restore_build_isolation``."""
     recursive_categories = tuple(recursive_categories or CATEGORIES)
     depths: dict[str, int] = {}
     level = package.direct_dependencies()

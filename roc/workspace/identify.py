@@ -1,11 +1,13 @@
 """Decide whether a directory is a package, and of which type, with colcon's precedence:
 
 1. ``COLCON_IGNORE`` prunes the directory.
+   Catkin and ament_tools install spaces (``_setup_util.py``, ``_order_isolated_packages.py``) prune too.
 2. ``colcon.pkg`` (JSON) may set the name and type and add dependencies, hooks and metadata.
 3. ``package.xml`` makes a ROS package (``AMENT_IGNORE``/``CATKIN_IGNORE`` prune; a ROS 1 ``manifest.xml``
    without package.xml prunes too).
-4. Otherwise ``CMakeLists.txt`` makes a ``cmake`` package and ``setup.py`` a ``python`` one; a directory
-   that is both is ambiguous and pruned, as colcon does.
+4. Otherwise ``CMakeLists.txt`` makes a ``cmake`` package (but not catkin_make's top-level file) and
+   ``setup.py`` a ``python`` one; CMake wins over setup.py, but a directory that is CMake and also has a
+   setup.cfg naming the project is ambiguous and pruned, as colcon does.
 """
 
 from __future__ import annotations
@@ -19,9 +21,11 @@ from roc.errors import ManifestError
 from roc.workspace.cmake_project import read_cmake_project
 from roc.workspace.manifest import parse_manifest
 from roc.workspace.package import CATEGORIES, Package
-from roc.workspace.python_setup import read_setup_cfg, read_setup_py, setup_cfg_is_sufficient
+from roc.workspace.python_setup import PythonProject, read_setup_cfg, read_setup_py, setup_cfg_is_sufficient
 
 IGNORE_MARKERS = ("COLCON_IGNORE", "AMENT_IGNORE", "CATKIN_IGNORE")
+# Files of catkin devel/install spaces and ament_tools install spaces, which hold no markers.
+INSTALL_SPACE_FILES = ("_setup_util.py", "_order_isolated_packages.py")
 
 
 class SkipLocation(Exception):
@@ -34,14 +38,14 @@ def warn(message: str) -> None:
 
 def identify(directory: Path, shown_path: Path, filenames: set[str], variables: Mapping[str, str]) -> Package | None:
     """The package at ``directory`` (``filenames`` are its files), None if it is not one."""
-    if "COLCON_IGNORE" in filenames:
+    if "COLCON_IGNORE" in filenames or not filenames.isdisjoint(INSTALL_SPACE_FILES):
         raise SkipLocation
     config = _read_colcon_pkg(directory / "colcon.pkg") if "colcon.pkg" in filenames else {}
     wanted_type = config.get("type")
     package = None
     if wanted_type is None or wanted_type.startswith("ros."):
         package = _identify_ros(directory, shown_path, filenames, variables)
-    if package is None and (wanted_type is None or not wanted_type.startswith("ros.")):
+    if package is None and _reads_build_files(config):
         package = _identify_build_system(directory, shown_path, filenames, wanted_type)
     if package is None:
         if wanted_type and config.get("name"):
@@ -50,6 +54,16 @@ def identify(directory: Path, shown_path: Path, filenames: set[str], variables: 
             return None
     _apply_colcon_pkg(package, config)
     return package
+
+
+def _reads_build_files(config: dict) -> bool:
+    """Whether CMakeLists.txt and setup.py are looked at: not for ROS types, and not when colcon.pkg sets
+    both the name and the type, which identifies the package by itself, so that colcon infers nothing
+    from its CMakeLists.txt (a Python package's requirements are still read)."""
+    wanted_type = config.get("type")
+    if wanted_type is None:
+        return True
+    return not wanted_type.startswith("ros.") and (wanted_type == "python" or not config.get("name"))
 
 
 def _identify_ros(directory: Path, shown_path: Path, filenames: set[str], variables) -> Package | None:
@@ -80,27 +94,37 @@ def _identify_ros(directory: Path, shown_path: Path, filenames: set[str], variab
 
 
 def _identify_build_system(directory: Path, shown_path: Path, filenames: set[str], wanted_type) -> Package | None:
-    found = []
+    """colcon's precedence: CMakeLists.txt and a setup.cfg that names the project (next to a setup.py
+    that calls a bare ``setup()``) identify at the same priority, so a directory with both is ambiguous;
+    setup.py alone comes after CMake."""
+    cmake = None
     if wanted_type in (None, "cmake") and "CMakeLists.txt" in filenames:
-        name, depends = read_cmake_project(directory / "CMakeLists.txt")
-        package = Package(name=name, path=shown_path, type="cmake")
-        package.dependencies.update(build=set(depends), run=set(depends))
-        found.append(package)
-    if wanted_type in (None, "python") and "setup.py" in filenames:
-        found.append(_identify_python(directory, shown_path, filenames))
-    if len(found) > 1:
-        warn(f"{shown_path}: both a CMake and a Python package; ignored (add a colcon.pkg that sets its type)")
-        raise SkipLocation
-    return found[0] if found else None
-
-
-def _identify_python(directory: Path, shown_path: Path, filenames: set[str]) -> Package:
+        cmake = _identify_cmake(directory, shown_path)
+    if wanted_type not in (None, "python") or "setup.py" not in filenames:
+        return cmake
     setup_py = directory / "setup.py"
     project = None
     if "setup.cfg" in filenames and setup_cfg_is_sufficient(setup_py):
         project = read_setup_cfg(directory / "setup.cfg")
+    if cmake is not None:
+        if project is not None:
+            warn(f"{shown_path}: both a CMake and a Python package; ignored (add a colcon.pkg that sets its type)")
+            raise SkipLocation
+        return cmake
+    return _python_package(project or read_setup_py(setup_py), shown_path)
+
+
+def _identify_cmake(directory: Path, shown_path: Path) -> Package | None:
+    project = read_cmake_project(directory / "CMakeLists.txt")
     if project is None:
-        project = read_setup_py(setup_py)
+        return None
+    name, depends = project
+    package = Package(name=name, path=shown_path, type="cmake")
+    package.dependencies.update(build=set(depends), run=set(depends))
+    return package
+
+
+def _python_package(project: PythonProject, shown_path: Path) -> Package:
     package = Package(name=project.name, path=shown_path, type="python")
     for category in CATEGORIES:
         package.dependencies[category] = set(project.dependencies.get(category, ()))

@@ -123,9 +123,10 @@ def select_packages(args: argparse.Namespace, ordered: list[Package], build_base
     def above(roots: set[str]) -> set[str]:
         return roots | {p.name for p in ordered if roots & deps_of(p.name).keys()}
 
-    if args.packages_up_to or args.packages_up_to_regex:
-        roots = set(args.packages_up_to or []) | {n for n in by_name if _matches(args.packages_up_to_regex, n)}
-        selected &= up_to(roots)
+    if args.packages_up_to:
+        selected &= up_to(set(args.packages_up_to))
+    if args.packages_up_to_regex:
+        selected &= up_to({n for n in by_name if _matches(args.packages_up_to_regex, n)})
     if args.packages_above:
         selected &= above(set(args.packages_above))
     if args.packages_above_and_dependencies:

@@ -1,0 +1,1 @@
+"""``roc work build``: packages become engine tasks run by build-type handlers."""

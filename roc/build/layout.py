@@ -1,0 +1,62 @@
+"""Where each package builds and installs, and the markers colcon leaves in the bases."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from roc.errors import RocError, UsageError
+from roc.fsutil import write_text_atomic
+
+LAYOUT_MARKER = ".colcon_install_layout"
+BUILT_BY_MARKER = ".built_by"
+# roc's build directories follow colcon's layout, so colcon may build in them and the other way round.
+COMPATIBLE_BUILD_TOOLS = ("colcon", "roc")
+
+
+def package_prefix(install_base: Path, name: str, merged: bool) -> Path:
+    return install_base if merged else install_base / name
+
+
+def prepare_build_base(build_base: Path) -> None:
+    marker = build_base / BUILT_BY_MARKER
+    if marker.is_file():
+        tool = marker.read_text().strip()
+        if tool not in COMPATIBLE_BUILD_TOOLS:
+            raise RocError(f"the build directory '{build_base}' was made by '{tool}'; "
+                           "remove it or choose another with --build-base")
+    else:
+        if build_base.exists() and not build_base.is_dir():
+            raise UsageError(f"--build-base '{build_base}' is not a directory")
+        write_text_atomic(marker, "colcon\n")
+    if not (build_base / "COLCON_IGNORE").exists():
+        write_text_atomic(build_base / "COLCON_IGNORE", "")
+
+
+def prepare_install_base(install_base: Path, merged: bool) -> None:
+    """Refuse to mix isolated and merged layouts in one install base."""
+    layout = "merged" if merged else "isolated"
+    marker = install_base / LAYOUT_MARKER
+    if marker.is_file():
+        previous = marker.read_text().strip()
+        if previous != layout:
+            change = "remove" if merged else "add"
+            raise UsageError(
+                f"the install base '{install_base}' has the {previous} layout; remove it, choose another "
+                f"--install-base, or {change} --merge-install"
+            )
+    else:
+        if install_base.exists() and not install_base.is_dir():
+            raise UsageError(f"--install-base '{install_base}' is not a directory")
+        write_text_atomic(marker, layout + "\n")
+    if not (install_base / "COLCON_IGNORE").exists():
+        write_text_atomic(install_base / "COLCON_IGNORE", "")
+
+
+def installed_packages(install_base: Path, merged: bool) -> dict[str, set[str]]:
+    """Packages installed in the base (built by roc or colcon), with their run dependencies."""
+    pattern = "share/colcon-core/packages/*" if merged else "*/share/colcon-core/packages/*"
+    found = {}
+    for marker in install_base.glob(pattern):
+        text = marker.read_text().strip()
+        found[marker.name] = set(text.split(":")) if text else set()
+    return found

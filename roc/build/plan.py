@@ -1,0 +1,95 @@
+"""Turn the selected packages into engine tasks: environment, handler, install hooks."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Callable
+
+from roc.build.finish import finish_package
+from roc.build.layout import package_prefix
+from roc.engine.graph import Task
+from roc.engine.jobserver import Jobserver
+from roc.engine.process import TaskContext, TaskError
+from roc.environment.dsv import apply_operations, resolve_operations
+from roc.fsutil import write_text_atomic
+from roc.handlers.cmake import build_cmake
+from roc.handlers.context import BuildOptions, PackageJob
+from roc.handlers.python import build_python
+from roc.workspace.graph import recursive_dependencies
+from roc.workspace.load import Workspace
+from roc.workspace.package import Package
+
+HANDLERS: dict[str, Callable[[TaskContext, PackageJob, BuildOptions], None]] = {
+    "ros.ament_cmake": build_cmake,
+    "ros.cmake": build_cmake,
+    "cmake": build_cmake,
+    "ros.ament_python": build_python,
+    "python": build_python,
+}
+ENVIRONMENT_FILE = "roc_build_environment.json"
+
+
+def build_environment(package: Package, dependencies: list[str], options: BuildOptions) -> dict[str, str]:
+    """The calling environment plus the install hooks of ``dependencies`` (in dependency order)."""
+    env = dict(os.environ)
+    for name in dependencies:
+        prefix = package_prefix(options.install_base, name, options.merge_install)
+        dsv = prefix / "share" / name / "package.dsv"
+        if dsv.is_file():
+            apply_operations(env, prefix, resolve_operations(prefix, dsv))
+    if package.type == "ros.ament_cmake":
+        # As colcon-ros does: CMake finds ament packages of every AMENT_PREFIX_PATH entry.
+        cmake_paths = [p for p in env.get("CMAKE_PREFIX_PATH", "").split(os.pathsep) if p]
+        extra = [p for p in env.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p and p not in cmake_paths]
+        env["CMAKE_PREFIX_PATH"] = os.pathsep.join(cmake_paths + extra)
+    return env
+
+
+def saved_environment(build_base: Path, name: str) -> dict[str, str] | None:
+    path = build_base / name / ENVIRONMENT_FILE
+    return json.loads(path.read_text()) if path.is_file() else None
+
+
+def plan_build(
+    workspace: Workspace, options: BuildOptions, jobserver: Jobserver | None, weights: dict[str, float]
+) -> list[Task]:
+    by_name = workspace.by_name
+    order = [p.name for p in workspace.ordered]
+    selected = workspace.selected
+    tasks = []
+    for package in workspace.selected_in_order():
+        if package.type not in HANDLERS:
+            raise TaskError(f"{package.path}: build type '{package.type}' is not supported by roc yet")
+        recursive = recursive_dependencies(package, by_name)
+        dependencies = [n for n in order if n in recursive]
+        tasks.append(Task(
+            name=package.name,
+            dependencies={n for n in dependencies if n in selected},
+            action=_package_action(package, workspace.root, dependencies, options, jobserver),
+            weight=weights.get(package.name, 1.0),
+        ))
+    return tasks
+
+
+def _package_action(package: Package, root: Path, dependencies: list[str], options: BuildOptions,
+                    jobserver: Jobserver | None):
+    def action(context: TaskContext) -> None:
+        env = build_environment(package, dependencies, options)
+        job = PackageJob(
+            package=package,
+            source=(root / package.path).resolve(),
+            build_dir=options.build_base / package.name,
+            prefix=package_prefix(options.install_base, package.name, options.merge_install),
+        )
+        job.env = env
+        if jobserver is not None:
+            job.make_flags = jobserver.makeflags(env.get("MAKEFLAGS", ""))
+            job.pass_fds = jobserver.fds
+        job.build_dir.mkdir(parents=True, exist_ok=True)
+        write_text_atomic(job.build_dir / ENVIRONMENT_FILE, json.dumps(env, indent=1, sort_keys=True))
+        HANDLERS[package.type](context, job, options)
+        finish_package(package, job.prefix)
+
+    return action

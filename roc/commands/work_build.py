@@ -1,0 +1,182 @@
+"""``roc work build``: build the workspace, a drop-in for ``colcon build``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from pathlib import Path
+
+from roc.errors import EXIT_FAILURE, EXIT_INTERRUPTED, UsageError
+from roc.workspace.selection import add_selection_arguments
+
+# colcon event handlers roc has, and the ones it accepts only when disabled.
+EVENT_HANDLERS = {"console_start_end", "console_stderr", "console_direct", "console_cohesion", "summary",
+                  "status", "log", "event_log", "store_result", "log_command"}
+NOT_SUPPORTED_HANDLERS = {"compile_commands", "desktop_notification", "terminal_title", "console_package_list",
+                          "parallel_status"}
+NOT_SUPPORTED_OPTIONS = ("test_result_base", "metas", "ignore_user_meta", "catkin_cmake_args",
+                         "catkin_skip_building_tests")
+# Options whose values are passed through to a tool and may themselves start with a dash.
+PASSTHROUGH_OPTIONS = ("--cmake-args", "--ament-cmake-args")
+DURATIONS_FILE = "roc_durations.json"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    add = parser.add_argument
+    add("packages", nargs="*", metavar="PKG_NAME", help="shorthand for --packages-up-to PKG_NAME...")
+    add("--build-base", default="build", help="base directory of the build directories (default: build)")
+    add("--install-base", default="install", help="base directory of the install prefixes (default: install)")
+    add("--log-base", default="log", help="base directory of the logs, or /dev/null for none (default: log)")
+    add("--merge-install", action="store_true", help="install all packages into one prefix")
+    add("--symlink-install", action="store_true", help="symlink installed files to the sources where possible")
+    add("--continue-on-error", action="store_true",
+        help="keep building packages that do not depend on a failed one (default: stop at the first failure)")
+    add("--executor", choices=("parallel", "sequential"), default="parallel", help="run packages in parallel "
+        "(default) or one at a time")
+    add("--parallel-workers", type=int, metavar="NUMBER", default=os.cpu_count() or 1,
+        help="packages built at once, 0 for no limit (default: the number of CPUs)")
+    add("-j", "--jobs", type=int, metavar="N",
+        help="compiler jobs of all packages together (default: -j of MAKEFLAGS, else the number of CPUs)")
+    add("--event-handlers", nargs="*", metavar="NAME+/-", default=[],
+        help="enable (+) or disable (-) output: console_start_end, console_stderr, console_direct, "
+             "console_cohesion, summary, status, log, event_log, store_result")
+    add("--output", choices=("text", "json"), default="text", help="json: one JSON event per line on stdout")
+    cmake = parser.add_argument_group("cmake and ament_cmake packages")
+    cmake.add_argument("--cmake-args", action="append", default=[], metavar="ARG",
+                       help="arguments for CMake (values may start with '-')")
+    cmake.add_argument("--cmake-target", help="build this target instead of the default one (no install)")
+    cmake.add_argument("--cmake-target-skip-unavailable", action="store_true",
+                       help="skip packages that do not have the --cmake-target")
+    cmake.add_argument("--cmake-clean-cache", action="store_true", help="remove the CMake cache first")
+    cmake.add_argument("--cmake-clean-first", action="store_true", help="build target 'clean' first")
+    cmake.add_argument("--cmake-force-configure", action="store_true", help="always run the CMake configure step")
+    cmake.add_argument("--ament-cmake-args", action="append", default=[], metavar="ARG",
+                       help="arguments for ament_cmake packages only")
+    unsupported = parser.add_argument_group("colcon options roc does not support yet (rejected if used)")
+    unsupported.add_argument("--test-result-base", help=argparse.SUPPRESS)
+    unsupported.add_argument("--metas", nargs="*", help=argparse.SUPPRESS)
+    unsupported.add_argument("--ignore-user-meta", action="store_true", default=None, help=argparse.SUPPRESS)
+    unsupported.add_argument("--catkin-cmake-args", nargs="*", help=argparse.SUPPRESS)
+    unsupported.add_argument("--catkin-skip-building-tests", action="store_true", default=None,
+                             help=argparse.SUPPRESS)
+    add_selection_arguments(parser)
+
+
+def rewrite_passthrough(argv: list[str], known_options: set[str]) -> list[str]:
+    """``--cmake-args -DA=1 -DB=2 --foo`` -> ``--cmake-args=-DA=1 --cmake-args=-DB=2 --foo``: values
+    run until the next roc option (a value that is also a roc option is written with a leading space)."""
+    result: list[str] = []
+    current = None
+    for token in argv:
+        if token in PASSTHROUGH_OPTIONS:
+            current = token
+            continue
+        if current and token.split("=", 1)[0] not in known_options:
+            result.append(f"{current}={token.lstrip(' ') if token.startswith(' ') else token}")
+            continue
+        current = None
+        result.append(token)
+    return result
+
+
+def _event_handler_switches(values: list[str]) -> dict[str, bool]:
+    switches: dict[str, bool] = {}
+    for value in values:
+        name, sign = value[:-1], value[-1:]
+        if sign not in "+-" or not name:
+            raise UsageError(f"--event-handlers: '{value}' must be a name followed by + or -")
+        if name in NOT_SUPPORTED_HANDLERS and sign == "+":
+            raise UsageError(f"--event-handlers: roc does not support '{name}' yet")
+        if name not in EVENT_HANDLERS | NOT_SUPPORTED_HANDLERS:
+            raise UsageError(f"--event-handlers: unknown handler '{name}'; "
+                             f"known: {', '.join(sorted(EVENT_HANDLERS))}")
+        switches[name] = sign == "+"
+    return switches
+
+
+def _check_supported(args: argparse.Namespace) -> None:
+    for option in NOT_SUPPORTED_OPTIONS:
+        if getattr(args, option) not in (None, False):
+            raise UsageError(f"--{option.replace('_', '-')} is not supported by roc yet")
+
+
+def run(args: argparse.Namespace) -> int:
+    from roc.build.layout import prepare_build_base, prepare_install_base
+    from roc.workspace.load import load_workspace
+
+    _check_supported(args)
+    switches = _event_handler_switches(args.event_handlers)
+    if args.packages:
+        args.packages_up_to = [*(args.packages_up_to or []), *args.packages]
+    if args.parallel_workers < 0:
+        raise UsageError("--parallel-workers must be 0 (no limit) or more")
+    workspace = load_workspace(args)
+    root = workspace.root
+    build_base = (root / args.build_base).absolute()
+    install_base = (root / args.install_base).absolute()
+    prepare_build_base(build_base)
+    prepare_install_base(install_base, args.merge_install)
+    return _build(args, workspace, build_base, install_base, switches)
+
+
+def _build(args, workspace, build_base: Path, install_base: Path, switches: dict[str, bool]) -> int:
+    from roc.build.layout import installed_packages
+    from roc.build.plan import plan_build
+    from roc.engine.executor import execute
+    from roc.engine.jobserver import Jobserver, jobs_from_makeflags
+    from roc.handlers.context import BuildOptions
+    from roc.output.console import ConsoleHandler
+    from roc.output.logs import JsonEventsHandler, LogHandler, ResultStore, new_log_directory
+    from roc.shell.scripts import write_install_scripts
+    from roc.workspace.graph import topological_order
+    from roc.workspace.package import Package
+
+    workers = 1 if args.executor == "sequential" else args.parallel_workers
+    jobs = args.jobs or jobs_from_makeflags(os.environ.get("MAKEFLAGS", "")) or os.cpu_count() or 1
+    options = BuildOptions(
+        build_base=build_base, install_base=install_base, merge_install=args.merge_install,
+        symlink_install=args.symlink_install, cmake_args=tuple(args.cmake_args),
+        ament_cmake_args=tuple(args.ament_cmake_args), cmake_target=args.cmake_target,
+        cmake_target_skip_unavailable=args.cmake_target_skip_unavailable,
+        cmake_clean_cache=args.cmake_clean_cache, cmake_clean_first=args.cmake_clean_first,
+        cmake_force_configure=args.cmake_force_configure, jobs=jobs,
+    )
+    durations_path = build_base / DURATIONS_FILE
+    weights = json.loads(durations_path.read_text()) if durations_path.is_file() else {}
+    jobserver = Jobserver(jobs, workers if workers > 0 else len(workspace.selected))
+    handlers = []
+    log_dir = None
+    if args.log_base != os.devnull and switches.get("log", True):
+        log_dir = new_log_directory((workspace.root / args.log_base).absolute())
+        handlers.append(LogHandler(log_dir))
+    if switches.get("store_result", True):
+        handlers.append(ResultStore(build_base))
+    if args.output == "json":
+        handlers.append(JsonEventsHandler(sys.stdout))
+    else:
+        handlers.append(ConsoleHandler(
+            start_end=switches.get("console_start_end", True), stderr=switches.get("console_stderr", True),
+            summary=switches.get("summary", True), direct=switches.get("console_direct", False),
+            cohesion=switches.get("console_cohesion", False), log_path=str(log_dir) if log_dir else None,
+        ))
+    try:
+        tasks = plan_build(workspace, options, jobserver, weights)
+        durations: dict[str, float] = dict(weights)
+        handlers.append(lambda e: durations.__setitem__(e.task, e.duration)
+                        if type(e).__name__ == "TaskFinished" and not e.cached else None)
+        result = execute(tasks, handlers, workers, continue_on_error=args.continue_on_error)
+    finally:
+        jobserver.close()
+    from roc.fsutil import write_text_atomic
+
+    write_text_atomic(durations_path, json.dumps(durations, indent=1, sort_keys=True))
+    installed = installed_packages(install_base, args.merge_install)
+    ordered = topological_order([Package(name=n, path=Path(n), type="", dependencies={"run": deps})
+                                 for n, deps in installed.items()])
+    underlays = [p for p in os.environ.get("COLCON_PREFIX_PATH", "").split(os.pathsep) if p]
+    write_install_scripts(install_base, [p.name for p in ordered], args.merge_install, underlays)
+    if result.interrupted:
+        return EXIT_INTERRUPTED
+    return 0 if result.ok else EXIT_FAILURE

@@ -1,0 +1,83 @@
+"""Events emitted while tasks run. Workers never print; handlers turn events into output and logs."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+
+@dataclass(frozen=True)
+class Event:
+    task: str
+    time: float = field(default_factory=time.time, compare=False)
+
+
+@dataclass(frozen=True)
+class TaskQueued(Event):
+    pass
+
+
+@dataclass(frozen=True)
+class TaskStarted(Event):
+    pass
+
+
+@dataclass(frozen=True)
+class CommandStarted(Event):
+    command: tuple[str, ...] = ()
+    cwd: str = ""
+
+
+@dataclass(frozen=True)
+class CommandEnded(Event):
+    command: tuple[str, ...] = ()
+    returncode: int = 0
+
+
+@dataclass(frozen=True)
+class TaskOutput(Event):
+    stream: str = "stdout"  # or "stderr"
+    data: bytes = b""
+
+
+@dataclass(frozen=True)
+class TaskProgress(Event):
+    percent: int = 0
+
+
+@dataclass(frozen=True)
+class TaskFinished(Event):
+    duration: float = 0.0
+    cached: bool = False  # skipped because it was up to date
+
+
+@dataclass(frozen=True)
+class TaskFailed(Event):
+    duration: float = 0.0
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class TaskAborted(Event):
+    """Stopped while running, because another task failed or the user interrupted."""
+
+    duration: float = 0.0
+
+
+@dataclass(frozen=True)
+class TaskSkipped(Event):
+    """Never started because a dependency failed or was aborted."""
+
+    because_of: str = ""
+
+
+@dataclass(frozen=True)
+class RunFinished(Event):
+    """The whole run ended; ``task`` is empty."""
+
+    interrupted: bool = False
+
+
+@dataclass(frozen=True)
+class Tick(Event):
+    """Sent to handlers while the executor waits, so that a live status line can refresh."""

@@ -1,0 +1,94 @@
+"""What is ready to run: Kahn's algorithm over a task graph, critical path first."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Iterable
+
+
+@dataclass
+class Task:
+    """A node of the graph. ``action`` runs in a worker; it raises TaskError to fail."""
+
+    name: str
+    dependencies: set[str]
+    action: Callable  # (TaskContext) -> None
+    weight: float = 1.0  # expected duration (seconds, or 1.0 when unknown)
+    jobs: int = 1  # compiler jobs it may use at most (informational for the scheduler)
+
+
+@dataclass
+class ReadyQueue:
+    """Hands out tasks whose dependencies have all finished, longest remaining chain first.
+
+    The priority of a task is its weight plus the largest priority among the tasks that depend on
+    it, so the chain that bounds the total time starts as early as possible.
+    """
+
+    tasks: dict[str, Task]
+    _waiting_on: dict[str, set[str]] = field(init=False)
+    _dependents: dict[str, set[str]] = field(init=False)
+    _priority: dict[str, float] = field(init=False)
+    _ready: set[str] = field(init=False)
+
+    def __post_init__(self) -> None:
+        names = self.tasks.keys()
+        self._waiting_on = {n: set(t.dependencies) & names for n, t in self.tasks.items()}
+        self._dependents = {n: set() for n in names}
+        for name, waiting in self._waiting_on.items():
+            for dependency in waiting:
+                self._dependents[dependency].add(name)
+        self._priority = {}
+        for name in self._reverse_topological():
+            later = [self._priority[d] for d in self._dependents[name]]
+            self._priority[name] = self.tasks[name].weight + max(later, default=0.0)
+        self._ready = {n for n, waiting in self._waiting_on.items() if not waiting}
+
+    def _reverse_topological(self) -> list[str]:
+        remaining = {n: len(d) for n, d in self._dependents.items()}
+        order = [n for n, count in remaining.items() if count == 0]
+        for name in order:  # the list grows while iterating: breadth-first from the sinks
+            for dependency in self._waiting_on[name]:
+                remaining[dependency] -= 1
+                if remaining[dependency] == 0:
+                    order.append(dependency)
+        if len(order) != len(self.tasks):
+            raise ValueError("the task graph has a cycle")
+        return order
+
+    def priority(self, name: str) -> float:
+        return self._priority[name]
+
+    def has_ready(self) -> bool:
+        return bool(self._ready)
+
+    def pop(self) -> Task:
+        """The ready task with the highest priority (ties: alphabetical)."""
+        name = min(self._ready, key=lambda n: (-self._priority[n], n))
+        self._ready.remove(name)
+        return self.tasks[name]
+
+    def done(self, name: str) -> None:
+        """``name`` succeeded: its dependents may become ready."""
+        for dependent in self._dependents[name]:
+            waiting = self._waiting_on[dependent]
+            waiting.discard(name)
+            if not waiting:
+                self._ready.add(dependent)
+
+    def downstream(self, name: str) -> list[str]:
+        """Every task that depends on ``name``, directly or not (they can no longer run)."""
+        seen: list[str] = []
+        stack = sorted(self._dependents[name])
+        while stack:
+            current = stack.pop()
+            if current in seen:
+                continue
+            seen.append(current)
+            stack.extend(sorted(self._dependents[current]))
+        return seen
+
+    def drop(self, names: Iterable[str]) -> None:
+        """Remove tasks that will never run (skipped) from the ready set."""
+        for name in names:
+            self._ready.discard(name)

@@ -1,0 +1,1 @@
+"""Package environments described by colcon's ``.dsv`` files, applied in Python or rendered to shell."""

@@ -1,0 +1,100 @@
+"""cmake and ament_cmake packages: configure when needed, build, install.
+
+Configure runs only when there is no CMake cache, the arguments changed (``cmake_args.last``, as
+colcon keeps it) or it is forced. Makefile builds take part in roc's global jobserver.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+from roc.engine.process import TaskContext, TaskError
+from roc.fsutil import write_text_atomic
+from roc.handlers.context import BuildOptions, PackageJob
+
+
+def cmake_arguments(job: PackageJob, options: BuildOptions) -> list[str]:
+    args = [*options.cmake_args]
+    if job.package.build_type == "ament_cmake":
+        args += options.ament_cmake_args
+        if options.symlink_install:
+            args.append("-DAMENT_CMAKE_SYMLINK_INSTALL=1")
+    return args
+
+
+def _cache_value(build_dir: Path, key: str) -> str | None:
+    try:
+        text = (build_dir / "CMakeCache.txt").read_text(errors="replace")
+    except OSError:
+        return None
+    match = re.search(rf"^{re.escape(key)}:[A-Z]+=(.*)$", text, re.MULTILINE)
+    return match.group(1) if match else None
+
+
+def _has_target(build_dir: Path, target: str) -> bool:
+    """Whether the generated build system has ``target`` (Makefile or Ninja)."""
+    makefile = build_dir / "Makefile"
+    if makefile.exists():
+        return re.search(rf"^{re.escape(target)}:", makefile.read_text(errors="replace"), re.MULTILINE) is not None
+    ninja = build_dir / "build.ninja"
+    if ninja.exists():
+        return re.search(rf"^build {re.escape(target)}:", ninja.read_text(errors="replace"), re.MULTILINE) is not None
+    return False
+
+
+def _check(context: TaskContext, job: PackageJob, command: list[str], what: str) -> None:
+    if context.run(command, cwd=str(job.build_dir), env=job.env, pass_fds=job.pass_fds) != 0:
+        raise TaskError(f"{what} failed")
+
+
+def build_cmake(context: TaskContext, job: PackageJob, options: BuildOptions) -> None:
+    build_dir = job.build_dir
+    build_dir.mkdir(parents=True, exist_ok=True)
+    args = cmake_arguments(job, options)
+    last_args = build_dir / "cmake_args.last"
+    recorded = repr(args) if args else "None"
+    if options.cmake_clean_cache:
+        (build_dir / "CMakeCache.txt").unlink(missing_ok=True)
+    needs_configure = (
+        options.cmake_force_configure
+        or not (build_dir / "CMakeCache.txt").exists()
+        or not last_args.exists()
+        or last_args.read_text() != recorded
+    )
+    if needs_configure:
+        command = ["cmake", str(job.source), *args, f"-DCMAKE_INSTALL_PREFIX={job.prefix}"]
+        _check(context, job, command, "CMake configure")
+        write_text_atomic(last_args, recorded)
+    targets = []
+    if options.cmake_clean_first:
+        targets.append("clean")
+    if options.cmake_target:
+        if not _has_target(build_dir, options.cmake_target):
+            if options.cmake_target_skip_unavailable:
+                return
+            raise TaskError(f"the package has no target '{options.cmake_target}'")
+        targets.append(options.cmake_target)
+    else:
+        targets.append("")  # the default target
+    for target in targets:
+        _check(context, job, _build_command(job, options, target), f"building target '{target or 'all'}'")
+    if not options.cmake_target and _has_target(build_dir, "install"):
+        _check(context, job, ["cmake", "--install", str(build_dir)], "install")
+
+
+def _build_command(job: PackageJob, options: BuildOptions, target: str) -> list[str]:
+    generator = _cache_value(job.build_dir, "CMAKE_GENERATOR") or ""
+    if generator == "Unix Makefiles" and job.make_flags:
+        make = _cache_value(job.build_dir, "CMAKE_MAKE_PROGRAM") or shutil.which("make") or "make"
+        # Run make directly so that it inherits the jobserver's file descriptors.
+        job.env["MAKEFLAGS"] = job.make_flags
+        return [make, *([target] if target else [])]
+    command = ["cmake", "--build", str(job.build_dir)]
+    if target:
+        command += ["--target", target]
+    if "Ninja" in generator or generator == "Unix Makefiles":
+        command += ["--", f"-j{options.jobs}"]
+    return command
+

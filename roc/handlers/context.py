@@ -1,0 +1,37 @@
+"""What a build-type handler needs to build one package."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from roc.workspace.package import Package
+
+
+@dataclass(frozen=True)
+class BuildOptions:
+    """The ``roc work build`` options that shape how packages are built."""
+
+    build_base: Path
+    install_base: Path
+    merge_install: bool = False
+    symlink_install: bool = False
+    cmake_args: tuple[str, ...] = ()
+    ament_cmake_args: tuple[str, ...] = ()
+    cmake_target: str | None = None
+    cmake_target_skip_unavailable: bool = False
+    cmake_clean_cache: bool = False
+    cmake_clean_first: bool = False
+    cmake_force_configure: bool = False
+    jobs: int = 2
+
+
+@dataclass
+class PackageJob:
+    package: Package
+    source: Path  # absolute package directory
+    build_dir: Path
+    prefix: Path  # the package's install prefix (the install base itself when merged)
+    env: dict[str, str] = field(default_factory=dict)
+    make_flags: str = ""  # MAKEFLAGS for make-based builds (jobserver client flags)
+    pass_fds: tuple[int, ...] = ()

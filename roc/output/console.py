@@ -1,0 +1,109 @@
+"""colcon-style console output: start/end lines, each package's stderr as one block, a summary."""
+
+from __future__ import annotations
+
+import sys
+import time
+from typing import TextIO
+
+from roc.engine.events import (
+    Event, RunFinished, TaskAborted, TaskFailed, TaskFinished, TaskOutput, TaskSkipped, TaskStarted,
+)
+
+
+def format_duration(seconds: float) -> str:
+    if seconds < 10:
+        return f"{seconds:.2f}s"
+    if seconds < 60:
+        return f"{seconds:.1f}s"
+    minutes, rest = divmod(int(round(seconds)), 60)
+    return f"{minutes}min {rest}s"
+
+
+def _count(n: int, word: str = "package") -> str:
+    return f"{n} {word}{'' if n == 1 else 's'}"
+
+
+class ConsoleHandler:
+    """Prints as colcon's console_start_end, console_stderr and summary handlers do.
+
+    ``direct`` echoes all output as it comes (console_direct+); ``cohesion`` prints each package's whole
+    output when it ends (console_cohesion+).
+    """
+
+    def __init__(self, stream: TextIO = sys.stdout, *, start_end: bool = True, stderr: bool = True,
+                 summary: bool = True, direct: bool = False, cohesion: bool = False, log_path: str | None = None):
+        self.stream = stream
+        self.start_end, self.stderr, self.summary = start_end, stderr, summary
+        self.direct, self.cohesion = direct, cohesion
+        self.log_path = log_path
+        self.started_at = time.monotonic()
+        self._stderr: dict[str, bytearray] = {}
+        self._all: dict[str, bytearray] = {}
+        self.finished: list[str] = []
+        self.cached: list[str] = []
+        self.failed: list[str] = []
+        self.aborted: list[str] = []
+        self.skipped: dict[str, str] = {}
+
+    def _print(self, text: str) -> None:
+        self.stream.write(text + "\n")
+        self.stream.flush()
+
+    def __call__(self, event: Event) -> None:
+        if isinstance(event, TaskOutput):
+            if self.direct:
+                target = sys.stderr if event.stream == "stderr" else self.stream
+                target.write(event.data.decode(errors="replace"))
+                target.flush()
+            if event.stream == "stderr":
+                self._stderr.setdefault(event.task, bytearray()).extend(event.data)
+            self._all.setdefault(event.task, bytearray()).extend(event.data)
+        elif isinstance(event, TaskStarted):
+            if self.start_end:
+                self._print(f"Starting >>> {event.task}")
+        elif isinstance(event, (TaskFinished, TaskFailed, TaskAborted)):
+            self._ended(event)
+        elif isinstance(event, TaskSkipped):
+            self.skipped[event.task] = event.because_of
+        elif isinstance(event, RunFinished) and self.summary:
+            self._print_summary(event)
+
+    def _ended(self, event: Event) -> None:
+        name = event.task
+        if self.cohesion and name in self._all:
+            self._print(f"--- output: {name}\n{self._all[name].decode(errors='replace').rstrip()}\n---")
+        elif self.stderr and not self.direct and name in self._stderr:
+            where = f" (log: {self.log_path}/{name}/stderr.log)" if self.log_path else ""
+            self._print(f"--- stderr: {name}{where}\n{self._stderr[name].decode(errors='replace').rstrip()}\n---")
+        if isinstance(event, TaskFinished):
+            (self.cached if event.cached else self.finished).append(name)
+            line = f"Finished <<< {name} [{'cached' if event.cached else format_duration(event.duration)}]"
+        elif isinstance(event, TaskFailed):
+            self.failed.append(name)
+            reason = event.reason.strip().splitlines()[-1] if event.reason.strip() else "failed"
+            line = f"Failed   <<< {name} [{format_duration(event.duration)}, {reason}]"
+        else:
+            self.aborted.append(name)
+            line = f"Aborted  <<< {name} [{format_duration(event.duration)}]"
+        if self.start_end or not isinstance(event, TaskFinished):
+            self._print(line)
+
+    def _print_summary(self, event: RunFinished) -> None:
+        total = format_duration(time.monotonic() - self.started_at)
+        lines = ["", f"Summary: {_count(len(self.finished) + len(self.cached))} finished [{total}]"]
+        if self.cached:
+            lines.append(f"  {_count(len(self.cached))} up to date (not rebuilt): {' '.join(sorted(self.cached))}")
+        if self.failed:
+            lines.append(f"  {_count(len(self.failed))} failed: {' '.join(sorted(self.failed))}")
+        if self.aborted:
+            lines.append(f"  {_count(len(self.aborted))} aborted: {' '.join(sorted(self.aborted))}")
+        if self.skipped:
+            causes = " ".join(f"{name} (needs {cause})" for name, cause in sorted(self.skipped.items()))
+            lines.append(f"  {_count(len(self.skipped))} skipped because a dependency failed: {causes}")
+        with_stderr = sorted(self._stderr)
+        if with_stderr:
+            lines.append(f"  {_count(len(with_stderr))} had stderr output: {' '.join(with_stderr)}")
+        if event.interrupted:
+            lines.append("  interrupted by the user")
+        self._print("\n".join(lines))

@@ -1,0 +1,106 @@
+"""colcon's log layout: ``<log-base>/build_<time>/`` with an events log and per-package logs,
+``latest_build`` and ``latest`` links, and each package's result in ``<build-base>/<pkg>/colcon_build.rc``."""
+
+from __future__ import annotations
+
+import json
+import os
+import shlex
+import time
+from dataclasses import asdict
+from pathlib import Path
+
+from roc.engine.events import (
+    CommandEnded, CommandStarted, Event, RunFinished, TaskAborted, TaskFailed, TaskFinished, TaskOutput, Tick,
+)
+from roc.fsutil import write_text_atomic
+from roc.workspace.selection import INTERRUPTED_RESULT
+
+
+def new_log_directory(log_base: Path, verb: str = "build") -> Path:
+    stamp = time.strftime("%Y-%m-%d_%H-%M-%S")
+    directory = log_base / f"{verb}_{stamp}"
+    suffix = 0
+    while directory.exists():
+        suffix += 1
+        directory = log_base / f"{verb}_{stamp}_{suffix}"
+    directory.mkdir(parents=True)
+    if not (log_base / "COLCON_IGNORE").exists():
+        write_text_atomic(log_base / "COLCON_IGNORE", "")
+    for name, target in ((f"latest_{verb}", directory.name), ("latest", f"latest_{verb}")):
+        link = log_base / name
+        temporary = log_base / f".{name}.tmp"
+        temporary.unlink(missing_ok=True)
+        temporary.symlink_to(target)
+        os.replace(temporary, link)
+    return directory
+
+
+class LogHandler:
+    def __init__(self, directory: Path):
+        self.directory = directory
+        self._events = open(directory / "events.log", "a", buffering=1)
+        self._files: dict[tuple[str, str], object] = {}
+
+    def _file(self, task: str, name: str):
+        key = (task, name)
+        if key not in self._files:
+            (self.directory / task).mkdir(exist_ok=True)
+            self._files[key] = open(self.directory / task / name, "ab")
+        return self._files[key]
+
+    def __call__(self, event: Event) -> None:
+        if isinstance(event, Tick):
+            return
+        record = {"event": type(event).__name__, **asdict(event)}
+        if isinstance(event, TaskOutput):
+            record["data"] = event.data.decode(errors="replace")
+            self._file(event.task, f"{event.stream}.log").write(event.data)
+            self._file(event.task, "stdout_stderr.log").write(event.data)
+            self._file(event.task, "streams.log").write(event.data)
+        elif isinstance(event, CommandStarted):
+            text = f"Invoking command in '{event.cwd}': {shlex.join(event.command)}\n".encode()
+            self._file(event.task, "command.log").write(text)
+            self._file(event.task, "streams.log").write(text)
+        elif isinstance(event, CommandEnded):
+            text = f"Invoked command '{shlex.join(event.command)}' returned '{event.returncode}'\n".encode()
+            self._file(event.task, "command.log").write(text)
+            self._file(event.task, "streams.log").write(text)
+        self._events.write(json.dumps(record) + "\n")
+        if isinstance(event, RunFinished):
+            self.close()
+
+    def close(self) -> None:
+        for handle in self._files.values():
+            handle.close()
+        self._files.clear()
+        self._events.close()
+
+
+class ResultStore:
+    """Writes each package's result where --packages-select-build-failed looks for it."""
+
+    def __init__(self, build_base: Path):
+        self.build_base = build_base
+
+    def __call__(self, event: Event) -> None:
+        results = {TaskFinished: "0", TaskFailed: "1", TaskAborted: INTERRUPTED_RESULT}
+        result = results.get(type(event))
+        if result is not None:
+            write_text_atomic(self.build_base / event.task / "colcon_build.rc", result + "\n")
+
+
+class JsonEventsHandler:
+    """``--output json``: one JSON object per event on stdout, for CI."""
+
+    def __init__(self, stream):
+        self.stream = stream
+
+    def __call__(self, event: Event) -> None:
+        if isinstance(event, Tick):
+            return
+        record = {"event": type(event).__name__, **asdict(event)}
+        if isinstance(event, TaskOutput):
+            record["data"] = event.data.decode(errors="replace")
+        self.stream.write(json.dumps(record) + "\n")
+        self.stream.flush()

@@ -1,0 +1,1 @@
+"""Generated shell scripts: per-package hooks and scripts, install-level setup scripts."""
