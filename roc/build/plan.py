@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 from pathlib import Path
 from typing import Callable
 
@@ -31,9 +32,19 @@ HANDLERS: dict[str, Callable[[TaskContext, PackageJob, BuildOptions], None]] = {
 ENVIRONMENT_FILE = "roc_build_environment.json"
 
 
-def build_environment(package: Package, dependencies: list[str], options: BuildOptions) -> dict[str, str]:
-    """The calling environment plus the install hooks of ``dependencies`` (in dependency order)."""
+def base_environment() -> dict[str, str]:
+    """The calling environment. When no ROS environment is sourced but roc's own Python prefix holds
+    ROS packages (ROS installed from wheels into a venv), that prefix is the underlay."""
     env = dict(os.environ)
+    prefix = Path(sys.prefix)
+    if not env.get("AMENT_PREFIX_PATH") and (prefix / "share" / "ament_index" / "resource_index").is_dir():
+        env["AMENT_PREFIX_PATH"] = str(prefix)
+    return env
+
+
+def build_environment(package: Package, dependencies: list[str], options: BuildOptions) -> dict[str, str]:
+    """The base environment plus the install hooks of ``dependencies`` (in dependency order)."""
+    env = base_environment()
     for name in dependencies:
         prefix = package_prefix(options.install_base, name, options.merge_install)
         dsv = prefix / "share" / name / "package.dsv"

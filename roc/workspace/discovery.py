@@ -40,6 +40,12 @@ def discover_packages(
     if base_paths is None and paths is None:
         base_paths = ["."]
     found: dict[str, Package] = {}  # real path -> package
+    # Base paths first: a package found both ways keeps its crawled path, as in colcon.
+    for base in _expand(base_paths or [], root):
+        start = root / base
+        if not start.is_dir():
+            raise UsageError(f"--base-paths: '{base}' is not a directory")
+        _crawl(start, Path(base), variables, found)
     for given in _expand(paths or [], root):
         directory = root / given
         if not directory.is_dir():
@@ -48,16 +54,12 @@ def discover_packages(
         if real in found:
             continue
         try:
-            package = identify(directory, Path(given), set(os.listdir(directory)), variables)
+            # colcon shows --paths packages by absolute path (normalised, symlinks kept)
+            package = identify(directory, Path(os.path.abspath(directory)), set(os.listdir(directory)), variables)
         except SkipLocation:
             continue
         if package:
             found[real] = package
-    for base in _expand(base_paths or [], root):
-        start = root / base
-        if not start.is_dir():
-            raise UsageError(f"--base-paths: '{base}' is not a directory")
-        _crawl(start, Path(base), variables, found)
     packages = sorted(found.values(), key=lambda p: (p.name, str(p.path)))
     _check_duplicates(packages)
     _resolve_groups(packages)

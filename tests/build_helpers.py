@@ -1,0 +1,62 @@
+"""Shared helpers for the build tests: run roc or colcon on a copy of a fixture workspace."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+FIXTURES = REPO / "workspaces" / "fixtures"
+BIN = Path(sys.executable).parent
+ENV_VARIABLES = ("AMENT_PREFIX_PATH", "CMAKE_PREFIX_PATH", "PYTHONPATH", "PATH", "LD_LIBRARY_PATH",
+                 "COLCON_PREFIX_PATH")
+
+
+def ros_env(**extra: str) -> dict[str, str]:
+    """The environment of a developer who has ROS (the venv's wheels) as underlay."""
+    env = {k: v for k, v in os.environ.items() if k not in ("COLCON_PREFIX_PATH", "AMENT_PREFIX_PATH")}
+    env["AMENT_PREFIX_PATH"] = sys.prefix
+    env["PATH"] = f"{BIN}{os.pathsep}{env.get('PATH', '/usr/bin:/bin')}"
+    env.update(extra)
+    return env
+
+
+def copy_fixture(name: str, destination: Path) -> Path:
+    shutil.copytree(FIXTURES / name, destination)
+    return destination
+
+
+def roc(*args: str, cwd: Path, env: dict[str, str] | None = None, timeout: float = 600) -> subprocess.CompletedProcess:
+    return subprocess.run([str(BIN / "roc"), *args], cwd=cwd, env=env or ros_env(), capture_output=True,
+                          text=True, timeout=timeout)
+
+
+def colcon(*args: str, cwd: Path, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run([str(BIN / "colcon"), *args], cwd=cwd, env=env or ros_env(), capture_output=True,
+                          text=True, timeout=900)
+
+
+def in_sourced_shell(workspace: Path, script: str, setup: str = "install/setup.bash",
+                     strict: bool = True) -> subprocess.CompletedProcess:
+    """Run ``script`` in a fresh bash that sourced ``setup`` (with ``set -u`` when ``strict``)."""
+    env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin",
+           "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
+    prelude = "set -eu; " if strict else ""
+    return subprocess.run(["bash", "-c", f'{prelude}source "{setup}"; {script}'], cwd=workspace, env=env,
+                          capture_output=True, text=True, timeout=120)
+
+
+def sourced_values(workspace: Path, setup: str = "install/setup.bash", strict: bool = True) -> dict[str, str]:
+    """The path-like variables after sourcing, with the workspace path replaced by WS."""
+    script = "; ".join(f'echo "{v}=${{{v}:-}}"' for v in ENV_VARIABLES)
+    result = in_sourced_shell(workspace, script, setup, strict)
+    assert result.returncode == 0, result.stderr
+    values = dict(line.split("=", 1) for line in result.stdout.splitlines())
+    return {k: v.replace(str(workspace), "WS") for k, v in values.items()}
+
+
+def installed_files(install: Path) -> set[str]:
+    return {str(p.relative_to(install)) for p in install.rglob("*") if not p.is_dir()}
