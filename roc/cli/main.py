@@ -22,6 +22,7 @@ COMMANDS = (
     (("work", "info"), (), "work_info", "show package details (like colcon info)"),
     (("work", "graph"), (), "work_graph", "show the dependency graph (like colcon graph)"),
     (("work", "build"), ("b",), "work_build", "build the workspace (a drop-in for colcon build)"),
+    (("work", "env"), (), "work_env", "print a package's build environment, or run a command in it"),
     (("completion",), (), "completion", "print a shell completion script: bash, zsh or fish"),
 )
 

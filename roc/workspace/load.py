@@ -33,9 +33,14 @@ class Workspace:
 def resolve_root(args: argparse.Namespace) -> Path:
     """Explicit --base-paths/--paths are taken from the current directory, as colcon does; otherwise
     roc looks upward for the workspace root and says so when it is not the current directory."""
-    cwd = Path.cwd()
     if args.base_paths is not None or args.paths is not None:
-        return cwd
+        return Path.cwd()
+    return find_workspace_root_for(args)
+
+
+def find_workspace_root_for(args: argparse.Namespace) -> Path:
+    """The workspace root around the current directory, announced when it is another directory."""
+    cwd = Path.cwd()
     root = find_workspace_root(cwd) or cwd
     if root != cwd:
         print(f"roc: using workspace root {root}", file=sys.stderr)

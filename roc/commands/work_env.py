@@ -1,0 +1,68 @@
+"""``roc work env PKG [-- CMD...]``: the environment a package is built in, printed or used to run CMD."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shlex
+import sys
+
+from roc.cli.output import add_format_argument, print_json
+from roc.errors import UsageError
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("package", metavar="PKG_NAME", help="the package")
+    parser.add_argument("command", nargs=argparse.REMAINDER, metavar="-- CMD",
+                        help="run CMD in that environment instead of printing it")
+    parser.add_argument("--build-base", default="build", help="build base (default: build)")
+    parser.add_argument("--install-base", default="install", help="install base (default: install)")
+    parser.add_argument("--merge-install", action="store_true", help="the install base has the merged layout")
+    add_format_argument(parser)
+
+
+def run(args: argparse.Namespace) -> int:
+    from roc.build.plan import build_environment, saved_environment
+    from roc.handlers.context import BuildOptions
+    from roc.workspace.graph import recursive_dependencies
+    from roc.workspace.load import find_workspace_root_for
+
+    root = find_workspace_root_for(args)
+    build_base = root / args.build_base
+    env = saved_environment(build_base, args.package)
+    if env is None:  # not built yet: what it would be built in now
+        from roc.workspace.load import load_workspace
+
+        args.base_paths = args.paths = None
+        workspace = load_workspace(_selection_defaults(args))
+        package = workspace.by_name.get(args.package)
+        if package is None:
+            raise UsageError(f"no package named '{args.package}' in the workspace; see 'roc work list -n'")
+        options = BuildOptions(build_base=build_base, install_base=root / args.install_base,
+                               merge_install=args.merge_install)
+        recursive = recursive_dependencies(package, workspace.by_name)
+        env = build_environment(package, [p.name for p in workspace.ordered if p.name in recursive], options)
+    command = args.command[1:] if args.command[:1] == ["--"] else args.command
+    if command:
+        sys.stdout.flush()
+        try:
+            os.execvpe(command[0], command, env)
+        except OSError as error:
+            raise UsageError(f"cannot run '{command[0]}': {error.strerror}") from None
+    if args.format == "json":
+        print_json(env)
+    else:
+        sys.stdout.write("".join(f"export {name}={shlex.quote(value)}\n" for name, value in sorted(env.items())))
+    return 0
+
+
+def _selection_defaults(args: argparse.Namespace) -> argparse.Namespace:
+    """This command has no selection options; give the loader their defaults."""
+    parser = argparse.ArgumentParser()
+    from roc.workspace.selection import add_selection_arguments
+
+    add_selection_arguments(parser)
+    defaults = parser.parse_args([])
+    for key, value in vars(args).items():
+        setattr(defaults, key, value)
+    return defaults
