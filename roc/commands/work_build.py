@@ -156,10 +156,16 @@ def _build(args, workspace, build_base: Path, install_base: Path, switches: dict
     if args.output == "json":
         handlers.append(JsonEventsHandler(sys.stdout))
     else:
+        status = None
+        if switches.get("status", True) and sys.stdout.isatty() and not os.environ.get("NO_COLOR"):
+            from roc.output.status import StatusLine
+
+            status = StatusLine()
         handlers.append(ConsoleHandler(
             start_end=switches.get("console_start_end", True), stderr=switches.get("console_stderr", True),
             summary=switches.get("summary", True), direct=switches.get("console_direct", False),
             cohesion=switches.get("console_cohesion", False), log_path=str(log_dir) if log_dir else None,
+            status=status,
         ))
     try:
         tasks = plan_build(workspace, options, jobserver, weights)

@@ -32,8 +32,10 @@ class ConsoleHandler:
     """
 
     def __init__(self, stream: TextIO = sys.stdout, *, start_end: bool = True, stderr: bool = True,
-                 summary: bool = True, direct: bool = False, cohesion: bool = False, log_path: str | None = None):
+                 summary: bool = True, direct: bool = False, cohesion: bool = False, log_path: str | None = None,
+                 status=None):
         self.stream = stream
+        self.status = status  # a StatusLine on a terminal: lines are printed above it
         self.start_end, self.stderr, self.summary = start_end, stderr, summary
         self.direct, self.cohesion = direct, cohesion
         self.log_path = log_path
@@ -47,6 +49,9 @@ class ConsoleHandler:
         self.skipped: dict[str, str] = {}
 
     def _print(self, text: str) -> None:
+        if self.status is not None:
+            self.status.print(text)
+            return
         self.stream.write(text + "\n")
         self.stream.flush()
 
@@ -66,8 +71,14 @@ class ConsoleHandler:
             self._ended(event)
         elif isinstance(event, TaskSkipped):
             self.skipped[event.task] = event.because_of
-        elif isinstance(event, RunFinished) and self.summary:
-            self._print_summary(event)
+        elif isinstance(event, RunFinished):
+            if self.status is not None:
+                self.status(event)  # stops the live line, before the summary
+                self.status = None
+            if self.summary:
+                self._print_summary(event)
+        if self.status is not None:
+            self.status(event)
 
     def _ended(self, event: Event) -> None:
         name = event.task

@@ -13,7 +13,7 @@ from typing import Mapping
 # wheels, where no setup script has exported them).
 DEFAULT_VARIABLES = {"ROS_VERSION": "2", "ROS_PYTHON_VERSION": "3"}
 
-_TOKEN = re.compile(r"\s*(?:(\()|(\))|(==|!=|<=|>=|<|>)|(\$\w+)|([^\s()=!<>$]+))")
+_TOKEN = re.compile(r"""\s*(?:(\()|(\))|(==|!=|<=|>=|<|>)|(\$\w+)|"([^"]*)"|'([^']*)'|([^\s()=!<>$"']+))""")
 _COMPARE = {
     "==": lambda a, b: a == b,
     "!=": lambda a, b: a != b,
@@ -54,7 +54,7 @@ def _tokenize(text: str) -> list[tuple[str, str]]:
         if not match or match.end() == pos:
             raise ConditionError(f"cannot parse condition '{text}' at column {pos + 1}")
         pos = match.end()
-        lparen, rparen, op, var, word = match.groups()
+        lparen, rparen, op, var, double_quoted, single_quoted, word = match.groups()
         if lparen:
             tokens.append(("(", lparen))
         elif rparen:
@@ -63,10 +63,12 @@ def _tokenize(text: str) -> list[tuple[str, str]]:
             tokens.append(("op", op))
         elif var:
             tokens.append(("var", var[1:]))
+        elif double_quoted is not None or single_quoted is not None:
+            tokens.append(("lit", double_quoted if double_quoted is not None else single_quoted))
         elif word in ("and", "or"):
             tokens.append((word, word))
         else:
-            tokens.append(("lit", word.strip("\"'")))
+            tokens.append(("lit", word))
     return tokens
 
 

@@ -135,12 +135,29 @@ def _python_package(project: PythonProject, shown_path: Path) -> Package:
 
 
 def _read_colcon_pkg(path: Path) -> dict:
+    """The JSON object in colcon.pkg. colcon reads the file as YAML, a superset of JSON (trailing commas,
+    comments, unquoted strings), so what strict JSON rejects is read as YAML too."""
     try:
-        data = json.loads(path.read_text(encoding="utf-8") or "{}")
-    except json.JSONDecodeError as error:
-        raise ManifestError(str(path), f"invalid JSON: {error.msg}; colcon.pkg must be a JSON object", error.lineno)
+        text = path.read_text(encoding="utf-8")
     except OSError as error:
         raise ManifestError(str(path), f"cannot be read: {error.strerror or error}") from None
+    if not text.strip():
+        return {}
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as error:
+        import yaml  # only for files that are not strict JSON
+
+        try:
+            data = yaml.safe_load(text)
+        except yaml.YAMLError:
+            raise ManifestError(
+                str(path), f"invalid JSON: {error.msg} at column {error.colno}; fix the syntax "
+                "(colcon.pkg holds one JSON object such as {\"name\": \"my_pkg\", \"type\": \"cmake\"})",
+                error.lineno,
+            ) from None
+    if data is None:
+        return {}
     if not isinstance(data, dict):
         raise ManifestError(str(path), "must hold a JSON object such as {\"name\": \"my_pkg\", \"type\": \"cmake\"}")
     return data

@@ -1,13 +1,14 @@
 """Read a Python package's name and requirements from setup.cfg / setup.py without running it.
 
-colcon runs every setup.py in a subprocess to learn its name; roc reads the file statically and only
-runs it when the name is computed at run time.
+colcon runs every setup.py in a subprocess to learn its name and requirements; roc reads the file
+statically and runs it only when one of the values it needs is computed at run time.
 """
 
 from __future__ import annotations
 
 import ast
 import configparser
+import json
 import re
 import subprocess
 import sys
@@ -20,6 +21,7 @@ _REQUIREMENT_NAME = re.compile(r"\s*([A-Za-z0-9][A-Za-z0-9._-]*)")
 # setup() keyword -> dependency category, as colcon maps them.
 REQUIREMENT_CATEGORIES = {"setup_requires": "build", "install_requires": "run", "tests_require": "test"}
 TEST_EXTRAS = ("test", "tests", "testing")
+SETUP_KEYWORDS = ("name", "version", *REQUIREMENT_CATEGORIES, "extras_require")
 
 
 @dataclass
@@ -36,8 +38,9 @@ def requirement_name(requirement: str) -> str | None:
 
 
 def _requirements(value) -> list[str]:
+    """Package names of requirements given as a list or as one requirement a line."""
     if isinstance(value, str):
-        value = value.replace(";", "\n").splitlines() if "\n" in value else [value]
+        value = value.splitlines()
     return [name for item in value or [] if (name := requirement_name(str(item)))]
 
 
@@ -59,11 +62,14 @@ def read_setup_cfg(setup_cfg: Path) -> PythonProject | None:
         for extra in TEST_EXTRAS:
             text = parser.get("options.extras_require", extra, fallback="")
             project.dependencies["test"].update(_requirements(text.strip().splitlines()))
-    for role in ("maintainer", "author"):
-        name_value = parser.get("metadata", role, fallback="").strip()
-        email = parser.get("metadata", f"{role}_email", fallback="").strip()
-        if email:
-            project.maintainers.append(f"{name_value} <{email}>" if name_value else email)
+    # The maintainers, else the authors, that have an email; both fields may list several, comma-separated.
+    role = "maintainer" if parser.has_option("metadata", "maintainer") else "author"
+    names = parser.get("metadata", role, fallback="")
+    emails = parser.get("metadata", f"{role}_email", fallback="")
+    if names and emails:
+        project.maintainers = [
+            f"{n.strip()} <{e.strip()}>" for n, e in zip(names.split(","), emails.split(","))
+        ]
     return project
 
 
@@ -74,23 +80,34 @@ def setup_cfg_is_sufficient(setup_py: Path) -> bool:
 
 
 def read_setup_py(setup_py: Path) -> PythonProject:
-    """The setup() arguments of setup.py, read statically; runs the file only for a computed name."""
+    """The setup() arguments colcon uses, read statically; the file is run (as colcon always does) only
+    when one of them is computed at run time."""
     try:
         tree = ast.parse(setup_py.read_bytes(), filename=str(setup_py))
     except SyntaxError as error:
         raise ManifestError(str(setup_py), f"invalid Python: {error.msg}", error.lineno) from None
     constants = _module_constants(tree)
     call = _find_setup_call(tree)
-    keywords = {k.arg: k.value for k in call.keywords if k.arg} if call else {}
-    name = _literal(keywords.get("name"), constants)
-    if not isinstance(name, str):
-        name = _run_setup_name(setup_py)
-    project = PythonProject(name=name)
-    version = _literal(keywords.get("version"), constants)
-    project.version = version if isinstance(version, str) else None
+    arguments: dict[str, object] | None = None
+    if call is not None and all(k.arg for k in call.keywords):  # no **kwargs
+        given = {k.arg: k.value for k in call.keywords if k.arg in SETUP_KEYWORDS}
+        arguments = {key: _literal(node, constants) for key, node in given.items()}
+        if not isinstance(arguments.get("name"), str) or any(v is None for v in arguments.values()):
+            arguments = None
+    if arguments is None:
+        arguments = _run_setup(setup_py)
+    return _project(arguments)
+
+
+def _project(arguments: dict[str, object]) -> PythonProject:
+    version = arguments.get("version")
+    project = PythonProject(name=str(arguments["name"]), version=version if isinstance(version, str) else None)
     for key, category in REQUIREMENT_CATEGORIES.items():
-        value = _literal(keywords.get(key), constants)
-        project.dependencies.setdefault(category, set()).update(_requirements(value if value else []))
+        project.dependencies[category] = set(_requirements(arguments.get(key)))
+    extras = arguments.get("extras_require")
+    if isinstance(extras, dict):
+        for extra in TEST_EXTRAS:
+            project.dependencies["test"].update(_requirements(extras.get(extra)))
     return project
 
 
@@ -123,6 +140,10 @@ def _literal(node: ast.AST | None, constants: dict[str, object]):
     if isinstance(node, (ast.List, ast.Tuple)):
         items = [_literal(e, constants) for e in node.elts]
         return None if any(i is None for i in items) else items
+    if isinstance(node, ast.Dict):
+        keys = [_literal(k, constants) for k in node.keys]  # a None key is a ``**mapping``
+        values = [_literal(v, constants) for v in node.values]
+        return None if any(i is None for i in keys + values) else dict(zip(keys, values))
     if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Add):
         left, right = _literal(node.left, constants), _literal(node.right, constants)
         if type(left) is type(right) and isinstance(left, (str, list)):
@@ -134,16 +155,39 @@ def _literal(node: ast.AST | None, constants: dict[str, object]):
         return None
 
 
-def _run_setup_name(setup_py: Path) -> str:
+# Runs setup.py with setup() replaced by a function that prints the arguments roc needs as JSON.
+_CAPTURE_SETUP = """
+import json, runpy, sys
+import setuptools
+captured = {}
+def setup(**kwargs):
+    captured.update(kwargs)
+setuptools.setup = setup
+try:
+    import distutils.core
+    distutils.core.setup = setup
+except ImportError:
+    pass
+sys.argv = ["setup.py"]
+runpy.run_path("setup.py", run_name="__main__")
+print(json.dumps({key: captured.get(key) for key in %r}, default=str))
+"""
+
+
+def _run_setup(setup_py: Path) -> dict[str, object]:
     try:
         result = subprocess.run(
-            [sys.executable, "setup.py", "--name"], cwd=setup_py.parent, capture_output=True, text=True, timeout=60
+            [sys.executable, "-c", _CAPTURE_SETUP % (SETUP_KEYWORDS,)],
+            cwd=setup_py.parent, capture_output=True, text=True, timeout=60,
         )
     except (OSError, subprocess.TimeoutExpired) as error:
-        raise ManifestError(str(setup_py), f"could not run it to learn the package name: {error}") from None
-    lines = [line.strip() for line in result.stdout.splitlines() if line.strip()]
-    if result.returncode != 0 or not lines:
+        raise ManifestError(str(setup_py), f"could not run it to read its setup() arguments: {error}") from None
+    lines = result.stdout.strip().splitlines()
+    arguments = json.loads(lines[-1]) if result.returncode == 0 and lines else {}
+    if not isinstance(arguments.get("name"), str):
+        error_lines = result.stderr.strip().splitlines()
+        detail = f" ({error_lines[-1]})" if error_lines else ""
         raise ManifestError(
-            str(setup_py), "cannot determine the package name; pass name='...' to setup() or add a setup.cfg"
+            str(setup_py), f"cannot determine the package name{detail}; pass name='...' to setup() or add a setup.cfg"
         )
-    return lines[-1]
+    return arguments

@@ -1,0 +1,73 @@
+"""The live status line on a terminal: elapsed time, done/total, running packages with progress.
+
+Progress is read from the build tools' own output: make's ``[ 45%]`` and ninja's ``[12/50]``.
+"""
+
+from __future__ import annotations
+
+import re
+import time
+
+from roc.engine.events import (
+    Event, RunFinished, TaskAborted, TaskFailed, TaskFinished, TaskOutput, TaskQueued, TaskSkipped, TaskStarted,
+)
+
+_MAKE_PROGRESS = re.compile(rb"\[\s*(\d{1,3})%\]")
+_NINJA_PROGRESS = re.compile(rb"\[(\d+)/(\d+)\]")
+
+
+def progress_of(data: bytes) -> int | None:
+    """The last progress percentage in a chunk of make or ninja output."""
+    found = None
+    for match in _MAKE_PROGRESS.finditer(data):
+        found = int(match.group(1))
+    for match in _NINJA_PROGRESS.finditer(data):
+        done, total = int(match.group(1)), int(match.group(2))
+        if total:
+            found = 100 * done // total
+    return found
+
+
+class StatusLine:
+    """Keeps a rich Live line under the normal output; ``print`` writes above it."""
+
+    def __init__(self) -> None:
+        from rich.console import Console
+        from rich.live import Live
+
+        self.console = Console(highlight=False)
+        self.live = Live(console=self.console, auto_refresh=False, transient=True)
+        self.live.start()
+        self.started = time.monotonic()
+        self.total = 0
+        self.done = 0
+        self.running: dict[str, int | None] = {}
+
+    def print(self, text: str) -> None:
+        self.console.print(text, markup=False, highlight=False, soft_wrap=True)
+
+    def __call__(self, event: Event) -> None:
+        if isinstance(event, TaskQueued):
+            self.total += 1
+        elif isinstance(event, TaskStarted):
+            self.running[event.task] = None
+        elif isinstance(event, TaskOutput) and event.task in self.running:
+            percent = progress_of(event.data)
+            if percent is not None:
+                self.running[event.task] = percent
+        elif isinstance(event, (TaskFinished, TaskFailed, TaskAborted, TaskSkipped)):
+            self.running.pop(event.task, None)
+            self.done += 1
+        elif isinstance(event, RunFinished):
+            self.live.stop()
+            return
+        self._refresh()
+
+    def _refresh(self) -> None:
+        from rich.text import Text
+
+        elapsed = time.monotonic() - self.started
+        running = " ".join(f"{name}{f' {p}%' if p is not None else ''}" for name, p in self.running.items())
+        line = f"[{elapsed:.1f}s] [{self.done}/{self.total} done] [{len(self.running)} running] {running}"
+        width = self.console.width or 80
+        self.live.update(Text(line[: width - 1], style="bold"), refresh=True)
