@@ -6,6 +6,7 @@ from pathlib import Path
 
 from roc.errors import RocError, UsageError
 from roc.fsutil import write_text_atomic
+from roc.workspace.graph import layered_order
 
 LAYOUT_MARKER = ".colcon_install_layout"
 BUILT_BY_MARKER = ".built_by"
@@ -52,11 +53,11 @@ def prepare_install_base(install_base: Path, merged: bool) -> None:
         write_text_atomic(install_base / "COLCON_IGNORE", "")
 
 
-def installed_packages(install_base: Path, merged: bool) -> dict[str, set[str]]:
-    """Packages installed in the base (built by roc or colcon), with their run dependencies."""
+def installed_in_order(install_base: Path, merged: bool) -> list[str]:
+    """Packages installed in the base (built by roc or colcon), dependencies first."""
     pattern = "share/colcon-core/packages/*" if merged else "*/share/colcon-core/packages/*"
-    found = {}
+    run_dependencies = {}
     for marker in install_base.glob(pattern):
         text = marker.read_text().strip()
-        found[marker.name] = set(text.split(":")) if text else set()
-    return found
+        run_dependencies[marker.name] = set(text.split(":")) if text else set()
+    return layered_order(run_dependencies)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 from pathlib import Path
@@ -122,16 +121,15 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _build(args, workspace, build_base: Path, install_base: Path, switches: dict[str, bool]) -> int:
-    from roc.build.layout import installed_packages
+    from roc.build.layout import installed_in_order
     from roc.build.plan import plan_build
     from roc.engine.executor import execute
     from roc.engine.jobserver import Jobserver, jobs_from_makeflags
+    from roc.engine.store import DurationStore
     from roc.handlers.context import BuildOptions
     from roc.output.console import ConsoleHandler
     from roc.output.logs import JsonEventsHandler, LogHandler, ResultStore, new_log_directory
     from roc.shell.scripts import write_install_scripts
-    from roc.workspace.graph import topological_order
-    from roc.workspace.package import Package
 
     workers = 1 if args.executor == "sequential" else args.parallel_workers
     jobs = args.jobs or jobs_from_makeflags(os.environ.get("MAKEFLAGS", "")) or os.cpu_count() or 1
@@ -143,8 +141,7 @@ def _build(args, workspace, build_base: Path, install_base: Path, switches: dict
         cmake_clean_cache=args.cmake_clean_cache, cmake_clean_first=args.cmake_clean_first,
         cmake_force_configure=args.cmake_force_configure, jobs=jobs,
     )
-    durations_path = build_base / DURATIONS_FILE
-    weights = json.loads(durations_path.read_text()) if durations_path.is_file() else {}
+    durations = DurationStore(build_base / DURATIONS_FILE)
     jobserver = Jobserver(jobs, workers if workers > 0 else len(workspace.selected))
     handlers = []
     log_dir = None
@@ -167,22 +164,16 @@ def _build(args, workspace, build_base: Path, install_base: Path, switches: dict
             cohesion=switches.get("console_cohesion", False), log_path=str(log_dir) if log_dir else None,
             status=status,
         ))
+    handlers.append(durations)
     try:
-        tasks = plan_build(workspace, options, jobserver, weights)
-        durations: dict[str, float] = dict(weights)
-        handlers.append(lambda e: durations.__setitem__(e.task, e.duration)
-                        if type(e).__name__ == "TaskFinished" and not e.cached else None)
+        tasks = plan_build(workspace, options, jobserver, durations.durations)
         result = execute(tasks, handlers, workers, continue_on_error=args.continue_on_error)
     finally:
         jobserver.close()
-    from roc.fsutil import write_text_atomic
-
-    write_text_atomic(durations_path, json.dumps(durations, indent=1, sort_keys=True))
-    installed = installed_packages(install_base, args.merge_install)
-    ordered = topological_order([Package(name=n, path=Path(n), type="", dependencies={"run": deps})
-                                 for n, deps in installed.items()])
+    durations.save()
     underlays = [p for p in os.environ.get("COLCON_PREFIX_PATH", "").split(os.pathsep) if p]
-    write_install_scripts(install_base, [p.name for p in ordered], args.merge_install, underlays)
+    write_install_scripts(install_base, installed_in_order(install_base, args.merge_install), args.merge_install,
+                          underlays)
     if result.interrupted:
         return EXIT_INTERRUPTED
     return 0 if result.ok else EXIT_FAILURE

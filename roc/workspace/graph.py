@@ -19,20 +19,29 @@ class DependencyCycleError(RocError):
     pass
 
 
+def layered_order(dependencies: dict[str, set[str]]) -> list[str]:
+    """Names in layers (each after all its dependencies), alphabetical within a layer.
+
+    Dependencies on names that are not keys are ignored; raises graphlib.CycleError on a cycle.
+    """
+    sorter = TopologicalSorter({name: deps & dependencies.keys() for name, deps in dependencies.items()})
+    sorter.prepare()
+    ordered: list[str] = []
+    while sorter.is_active():
+        ready = sorted(sorter.get_ready())
+        ordered.extend(ready)
+        sorter.done(*ready)
+    return ordered
+
+
 def topological_order(packages: Iterable[Package]) -> list[Package]:
     """Packages in colcon's flat topological order; raises DependencyCycleError on a cycle."""
     by_name = {p.name: p for p in packages}
-    sorter = TopologicalSorter({name: p.direct_dependencies() & by_name.keys() for name, p in by_name.items()})
     try:
-        sorter.prepare()
+        names = layered_order({name: p.direct_dependencies() for name, p in by_name.items()})
     except CycleError as error:
         raise _cycle_error(error.args[1], by_name) from None
-    ordered: list[Package] = []
-    while sorter.is_active():
-        ready = sorted(sorter.get_ready())
-        ordered.extend(by_name[name] for name in ready)
-        sorter.done(*ready)
-    return ordered
+    return [by_name[name] for name in names]
 
 
 def _cycle_error(cycle: list[str], by_name: dict[str, Package]) -> DependencyCycleError:
