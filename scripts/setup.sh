@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# Set up roc's development/CI environment in <repo>/.venv:
+#   - a venv made with python3 -m venv (or $PYTHON -m venv),
+#   - roc installed editable with its test extra (pytest, pytest-xdist, colcon as test oracle),
+#   - the ROS 2 Jazzy PyPI wheels of requirements/ros-jazzy.txt,
+#   - the fix-ups of those wheels' CMake files (scripts/fix_ros_wheels.py).
+# Idempotent: when nothing it depends on changed since the last successful run (stamp in
+# .venv/.roc-setup-stamp) it only re-checks the fix-ups and prints one line.
+# Only the dev/CI environment lives here: roc itself never assumes the venv's paths.
+# Environment: PYTHON (interpreter that creates the venv, default python3),
+#              ROC_SETUP_FORCE=1 (redo the pip steps even if the stamp matches).
+set -euo pipefail
+
+ROOT="$(cd -- "$(dirname -- "${BASH_SOURCE[0]}")/.." && pwd -P)"
+VENV="$ROOT/.venv"
+VPY="$VENV/bin/python"
+STAMP="$VENV/.roc-setup-stamp"
+PYTHON="${PYTHON:-python3}"
+
+say() { printf 'setup: %s\n' "$*" >&2; }
+die() { printf 'setup: error: %s\n' "$*" >&2; exit 1; }
+# pip, without the machine-wide config's warnings about absent local index folders.
+pip_q() {
+    "$VPY" -m pip "$@" 2>&1 \
+        | { grep -v -E "^WARNING: Location 'file://[^']*' is ignored: it is neither a file nor a directory\.\$" || true; } >&2
+}
+
+# One setup at a time per checkout (e.g. two test runs started together).
+if command -v flock >/dev/null 2>&1; then
+    LOCK="${TMPDIR:-/tmp}/roc-setup-$(printf '%s' "$ROOT" | sha256sum | cut -c1-16).lock"
+    exec 9>"$LOCK"
+    flock 9
+fi
+
+# Everything whose change must redo the set-up.
+stamp_inputs() {
+    local f
+    for f in "$ROOT/scripts/setup.sh" "$ROOT/scripts/fix_ros_wheels.py" "$ROOT/pyproject.toml" \
+             "$ROOT"/requirements/*.txt; do
+        [ -f "$f" ] && printf '%s\n' "${f#"$ROOT"/}" && cat -- "$f"
+    done
+    # the interpreter the venv runs on
+    "$VPY" -c 'import sys; print(sys.version)' 2>/dev/null || true
+}
+want_stamp() { stamp_inputs | sha256sum | cut -d' ' -f1; }
+
+# The venv works and its roc is this checkout's.
+venv_ok() {
+    [ -x "$VPY" ] && "$VPY" -I - "$ROOT" <<'EOF' >/dev/null 2>&1
+import os, sys
+import roc
+sys.exit(0 if os.path.realpath(roc.__file__).startswith(os.path.realpath(sys.argv[1]) + os.sep) else 1)
+EOF
+}
+
+# ---- quick path -------------------------------------------------------------------------
+if [ "${ROC_SETUP_FORCE:-0}" != 1 ] && [ -f "$STAMP" ] && venv_ok \
+        && [ "$(cat -- "$STAMP")" = "$(want_stamp)" ]; then
+    # Cheap safety net in case a wheel was reinstalled by hand: silent when nothing changes.
+    "$VPY" "$ROOT/scripts/fix_ros_wheels.py" --quiet
+    say "environment up to date ($VENV); set ROC_SETUP_FORCE=1 to redo it"
+    exit 0
+fi
+
+start=$SECONDS
+export PIP_NO_INPUT=1 PIP_DISABLE_PIP_VERSION_CHECK=1
+
+# ---- venv -------------------------------------------------------------------------------
+if [ ! -x "$VPY" ] || ! "$VPY" -c '' >/dev/null 2>&1; then
+    command -v "$PYTHON" >/dev/null 2>&1 || die "'$PYTHON' not found (set PYTHON=/path/to/python3.11)"
+    if [ -e "$VENV" ]; then
+        say "rebuilding the broken venv at $VENV"
+        "$PYTHON" -m venv --clear "$VENV" || die "'$PYTHON -m venv' failed (on Debian: apt-get install python3-venv)"
+    else
+        say "creating the venv at $VENV with $("$PYTHON" --version 2>&1)"
+        "$PYTHON" -m venv "$VENV" || die "'$PYTHON -m venv' failed (on Debian: apt-get install python3-venv)"
+    fi
+fi
+rm -f -- "$STAMP"
+
+# ---- packages ---------------------------------------------------------------------------
+say "upgrading pip"
+pip_q install -q --upgrade pip
+
+say "installing roc (editable, with the test extra) and the ROS 2 Jazzy wheels"
+pip_q install -q -e "$ROOT[test]" -r "$ROOT/requirements/ros-jazzy.txt"
+
+# ---- fix-ups of the wheels' CMake files ---------------------------------------------------
+"$VPY" "$ROOT/scripts/fix_ros_wheels.py"
+
+# ---- smoke check --------------------------------------------------------------------------
+"$VPY" -I -c 'import rclpy, std_msgs.msg, std_srvs.srv, test_msgs.action, roc' \
+    || die "the installed environment does not import rclpy/std_msgs/std_srvs/test_msgs/roc"
+[ -x "$VENV/bin/roc" ] || die "$VENV/bin/roc is missing"
+[ -x "$VENV/bin/colcon" ] || die "$VENV/bin/colcon is missing"
+
+want_stamp >"$STAMP"
+say "done in $((SECONDS - start)) s: run roc as $VENV/bin/roc (or 'source .venv/bin/activate')"

@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Set up the environment (scripts/setup.sh, quick when already done), then run the whole
+# test suite on 2 cores with pytest-xdist. Extra arguments go to pytest, e.g.
+#   bash scripts/test.sh -k graph -x
+set -euo pipefail
+
+ROOT="$(cd -- "$(dirname -- "${BASH_SOURCE[0]}")/.." && pwd -P)"
+cd "$ROOT"
+
+bash "$ROOT/scripts/setup.sh"
+
+rc=0
+"$ROOT/.venv/bin/python" -m pytest -n 2 tests "$@" </dev/null || rc=$?
+if [ "$rc" -eq 5 ]; then
+    echo "test: error: pytest collected no tests (exit code 5); treating it as a failure" >&2
+    exit 1
+fi
+exit "$rc"
