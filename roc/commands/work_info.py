@@ -6,7 +6,7 @@ import argparse
 import difflib
 
 from roc.cli.output import add_format_argument, print_json, print_lines
-from roc.errors import UsageError
+from roc.errors import RocError, UsageError
 from roc.workspace.package import Package
 from roc.workspace.selection import add_selection_arguments
 
@@ -21,6 +21,8 @@ def run(args: argparse.Namespace) -> int:
     from roc.workspace.load import load_workspace
 
     workspace = load_workspace(args)
+    if not workspace.ordered:  # as colcon info, which fails with "No packages found"
+        raise RocError(f"no packages found in {workspace.root}; run roc in a workspace or pass --base-paths")
     by_name = workspace.by_name
     unknown = [n for n in args.package_names if n not in by_name]
     if unknown:
