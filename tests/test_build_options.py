@@ -1,0 +1,105 @@
+"""roc work build options on quick plain-CMake packages: configure caching, targets, output, job budget."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from build_helpers import roc
+
+SHOW_MAKEFLAGS = """cmake_minimum_required(VERSION 3.8)
+project({name} C)
+add_custom_target(show ALL COMMAND printenv MAKEFLAGS)
+add_custom_target(only_here COMMAND echo only-here-ran)
+install(FILES CMakeLists.txt DESTINATION share/{name})
+"""
+
+
+@pytest.fixture
+def ws(tmp_path) -> Path:
+    for name in ("alpha", "beta"):
+        directory = tmp_path / "src" / name
+        directory.mkdir(parents=True)
+        (directory / "CMakeLists.txt").write_text(SHOW_MAKEFLAGS.format(name=name))
+    (tmp_path / "src" / "beta" / "CMakeLists.txt").write_text(
+        SHOW_MAKEFLAGS.format(name="beta").replace("add_custom_target(only_here COMMAND echo only-here-ran)\n", ""))
+    return tmp_path
+
+
+def _commands(ws: Path, package: str) -> str:
+    return (ws / "log" / "latest_build" / package / "command.log").read_text()
+
+
+def test_configure_runs_only_when_needed(ws):
+    assert roc("work", "build", cwd=ws).returncode == 0
+    assert "Invoking command in" in _commands(ws, "alpha") and "cmake " in _commands(ws, "alpha")
+    assert (ws / "build" / "alpha" / "cmake_args.last").read_text() == "None"
+    assert roc("work", "build", cwd=ws).returncode == 0
+    assert "-DCMAKE_INSTALL_PREFIX" not in _commands(ws, "alpha")  # no configure: nothing changed
+    changed = roc("work", "build", "--cmake-args", "-DSOME_OPTION=ON", cwd=ws)
+    assert changed.returncode == 0, changed.stderr
+    assert "-DSOME_OPTION=ON" in _commands(ws, "alpha")
+    assert (ws / "build" / "alpha" / "cmake_args.last").read_text() == "['-DSOME_OPTION=ON']"
+    forced = roc("work", "build", "--cmake-args", "-DSOME_OPTION=ON", "--cmake-force-configure", cwd=ws)
+    assert forced.returncode == 0 and "-DSOME_OPTION=ON" in _commands(ws, "alpha")
+
+
+def test_cmake_target_and_skip_unavailable(ws):
+    assert roc("work", "build", cwd=ws).returncode == 0
+    missing = roc("work", "build", "--cmake-target", "only_here", cwd=ws)
+    assert missing.returncode == 1 and "no target 'only_here'" in missing.stdout
+    result = roc("work", "build", "--cmake-target", "only_here", "--cmake-target-skip-unavailable",
+                 "--event-handlers", "console_cohesion+", cwd=ws)
+    assert result.returncode == 0, result.stdout
+    assert "only-here-ran" in result.stdout
+
+
+def test_global_job_budget_is_one_jobserver(ws):
+    result = roc("work", "build", "-j", "3", "--event-handlers", "console_direct+", cwd=ws)
+    assert result.returncode == 0, result.stderr
+    flags = [line for line in result.stdout.splitlines() if "--jobserver-auth=" in line]
+    assert len(flags) == 2 and all("-j3" in f for f in flags), result.stdout
+    assert len({f.split("--jobserver-auth=")[1] for f in flags}) == 1  # the same jobserver for both packages
+
+
+def test_json_events_for_ci(ws):
+    result = roc("work", "build", "--output", "json", cwd=ws)
+    assert result.returncode == 0
+    events = [json.loads(line) for line in result.stdout.splitlines()]
+    kinds = {e["event"] for e in events}
+    assert {"TaskQueued", "TaskStarted", "CommandStarted", "TaskOutput", "TaskFinished", "RunFinished"} <= kinds
+    assert sorted(e["task"] for e in events if e["event"] == "TaskFinished") == ["alpha", "beta"]
+
+
+def test_quiet_handlers_and_no_logs(ws):
+    result = roc("work", "build", "--event-handlers", "console_start_end-", "summary-", "--log-base", "/dev/null",
+                 cwd=ws)
+    assert result.returncode == 0 and result.stdout == ""
+    assert not (ws / "log").exists()
+
+
+@pytest.mark.parametrize("option", [["--test-result-base", "x"], ["--metas", "a"], ["--catkin-skip-building-tests"],
+                                    ["--event-handlers", "compile_commands+"], ["--event-handlers", "nonsense+"]])
+def test_unsupported_options_are_rejected(ws, option):
+    result = roc("work", "build", *option, cwd=ws)
+    assert result.returncode == 2
+    assert result.stderr.startswith("roc: error:") and len(result.stderr.splitlines()) == 1
+    assert not (ws / "build").exists()
+
+
+def test_positional_names_mean_up_to(ws):
+    result = roc("work", "build", "beta", cwd=ws)
+    assert result.returncode == 0
+    assert "Starting >>> beta" in result.stdout and "alpha" not in result.stdout
+
+
+def test_env_prints_and_runs_the_build_environment(ws):
+    assert roc("work", "build", cwd=ws).returncode == 0
+    printed = roc("work", "env", "alpha", cwd=ws)
+    assert printed.returncode == 0 and "export AMENT_PREFIX_PATH=" in printed.stdout
+    ran = roc("work", "env", "alpha", "--", "sh", "-c", "echo $AMENT_PREFIX_PATH", cwd=ws / "src" / "alpha")
+    assert ran.returncode == 0 and ran.stdout.strip() and "using workspace root" in ran.stderr
+    unknown = roc("work", "env", "gamma", cwd=ws)
+    assert unknown.returncode == 2 and "gamma" in unknown.stderr
