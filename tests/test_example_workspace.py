@@ -8,7 +8,7 @@ import subprocess
 
 import pytest
 
-from build_helpers import BIN, REPO, in_sourced_shell, roc
+from build_helpers import BIN, REPO, colcon, in_sourced_shell, installed_files, roc, sourced_values
 
 pytestmark = pytest.mark.slow
 
@@ -61,3 +61,22 @@ def test_python_node_messages_arrive(example):
     assert listener.returncode == 0, output
     received = [line for line in output.splitlines() if "Received reading" in line]
     assert len(received) == 3 and all("celsius" in line for line in received), output
+
+
+@pytest.mark.colcon
+def test_same_install_tree_and_environment_as_colcon(example, tmp_path):
+    theirs = tmp_path / "colcon"
+    shutil.copytree(REPO / "workspaces" / "example" / "src", theirs / "src")
+    result = colcon("build", "--parallel-workers", "2", cwd=theirs)
+    assert result.returncode == 0, result.stdout + result.stderr
+    ours_files, theirs_files = installed_files(example / "install"), installed_files(theirs / "install")
+    # Justified differences: roc writes no PowerShell scripts yet and needs no _local_setup_util_*.py;
+    # byte-code caches depend on who imported what.
+    def comparable(files):
+        return {f for f in files if not f.endswith((".ps1", ".pyc")) and "_local_setup_util_" not in f}
+    assert comparable(ours_files) == comparable(theirs_files)
+    ours_env = sourced_values(example)
+    theirs_env = sourced_values(theirs, strict=False)
+    theirs_env["LD_LIBRARY_PATH"] = theirs_env["LD_LIBRARY_PATH"].rstrip(":")  # colcon's empty entry
+    assert {k: v.replace(str(example), "WS") for k, v in ours_env.items()} == \
+        {k: v.replace(str(theirs), "WS") for k, v in theirs_env.items()}

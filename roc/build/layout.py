@@ -54,10 +54,10 @@ def prepare_install_base(install_base: Path, merged: bool) -> None:
 
 
 def installed_in_order(install_base: Path, merged: bool) -> list[str]:
-    """Packages installed in the base (built by roc or colcon), dependencies first."""
+    """Packages installed in the base (built by roc or colcon) in the order colcon's setup scripts use."""
     pattern = "share/colcon-core/packages/*" if merged else "*/share/colcon-core/packages/*"
     run_dependencies = {}
     for marker in install_base.glob(pattern):
         text = marker.read_text().strip()
         run_dependencies[marker.name] = set(text.split(":")) if text else set()
-    return layered_order(run_dependencies)
+    return layered_order(run_dependencies, one_at_a_time=True)

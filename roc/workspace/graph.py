@@ -19,18 +19,23 @@ class DependencyCycleError(RocError):
     pass
 
 
-def layered_order(dependencies: dict[str, set[str]]) -> list[str]:
-    """Names in layers (each after all its dependencies), alphabetical within a layer.
+def layered_order(dependencies: dict[str, set[str]], one_at_a_time: bool = False) -> list[str]:
+    """Names each after all its dependencies: in layers, alphabetical within a layer (colcon's build
+    order), or ``one_at_a_time``: always the alphabetically first ready name (colcon's setup scripts).
 
     Dependencies on names that are not keys are ignored; raises graphlib.CycleError on a cycle.
     """
     sorter = TopologicalSorter({name: deps & dependencies.keys() for name, deps in dependencies.items()})
     sorter.prepare()
     ordered: list[str] = []
+    ready: list[str] = []
     while sorter.is_active():
-        ready = sorted(sorter.get_ready())
-        ordered.extend(ready)
-        sorter.done(*ready)
+        ready.extend(sorter.get_ready())
+        ready.sort()
+        placed = ready[:1] if one_at_a_time else ready[:]
+        del ready[:len(placed)]
+        ordered.extend(placed)
+        sorter.done(*placed)
     return ordered
 
 
