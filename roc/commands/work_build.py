@@ -142,7 +142,7 @@ def _build(args, workspace, build_base: Path, install_base: Path, switches: dict
         cmake_force_configure=args.cmake_force_configure, jobs=jobs,
     )
     durations = DurationStore(build_base / DURATIONS_FILE)
-    jobserver = Jobserver(jobs, workers if workers > 0 else len(workspace.selected))
+    jobserver = Jobserver(jobs)
     handlers = []
     log_dir = None
     if args.log_base != os.devnull and switches.get("log", True):

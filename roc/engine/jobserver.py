@@ -1,7 +1,8 @@
 """A GNU make jobserver shared by every package build: one global budget of compiler jobs.
 
-Each make that joins holds one implicit job slot, so the pipe holds ``jobs - workers`` tokens and at
-most ``max(jobs, workers)`` compilers run at once, instead of colcon's workers x jobs.
+The pipe holds ``jobs - 1`` tokens and each make that joins holds one implicit slot (make's own
+convention), so a package building alone can use the whole budget, and at most ``jobs + workers - 1``
+compilers run at once, instead of colcon's workers x jobs.
 """
 
 from __future__ import annotations
@@ -22,10 +23,10 @@ def jobs_from_makeflags(makeflags: str) -> int | None:
 
 
 class Jobserver:
-    def __init__(self, jobs: int, workers: int):
+    def __init__(self, jobs: int):
         self.jobs = jobs
         self.read_fd, self.write_fd = os.pipe()
-        tokens = max(0, jobs - max(1, workers))
+        tokens = max(0, jobs - 1)
         if tokens:
             os.write(self.write_fd, b"+" * tokens)
 
