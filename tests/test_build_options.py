@@ -36,8 +36,8 @@ def test_configure_runs_only_when_needed(ws):
     assert roc("work", "build", cwd=ws).returncode == 0
     assert "Invoking command in" in _commands(ws, "alpha") and "cmake " in _commands(ws, "alpha")
     assert (ws / "build" / "alpha" / "cmake_args.last").read_text() == "None"
-    assert roc("work", "build", cwd=ws).returncode == 0
-    assert "-DCMAKE_INSTALL_PREFIX" not in _commands(ws, "alpha")  # no configure: nothing changed
+    assert roc("work", "build", "--force", cwd=ws).returncode == 0  # --force: build even if up to date
+    assert "-DCMAKE_INSTALL_PREFIX" not in _commands(ws, "alpha")  # but no configure: nothing changed
     changed = roc("work", "build", "--cmake-args", "-DSOME_OPTION=ON", cwd=ws)
     assert changed.returncode == 0, changed.stderr
     assert "-DSOME_OPTION=ON" in _commands(ws, "alpha")

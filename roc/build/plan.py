@@ -9,6 +9,8 @@ from pathlib import Path
 from typing import Callable
 
 from roc.build.finish import finish_package
+from roc.build.fingerprint import combine, source_digest, toolchain_digest
+from roc.build.state import install_intact, read_state, write_state
 from roc.build.layout import package_prefix
 from roc.engine.graph import Task
 from roc.engine.jobserver import Jobserver
@@ -63,44 +65,82 @@ def saved_environment(build_base: Path, name: str) -> dict[str, str] | None:
     return json.loads(path.read_text()) if path.is_file() else None
 
 
+def _options_digest(package: Package, options: BuildOptions, prefix: Path) -> dict:
+    """The options that shape this package's build."""
+    cmake_based = package.build_type in ("cmake", "ament_cmake")
+    return {
+        "type": package.type,
+        "prefix": str(prefix),
+        "merge": options.merge_install,
+        "symlink": options.symlink_install,
+        "cmake_args": list(options.cmake_args) if cmake_based else [],
+        "ament_cmake_args": list(options.ament_cmake_args) if package.build_type == "ament_cmake" else [],
+    }
+
+
 def plan_build(
     workspace: Workspace, options: BuildOptions, jobserver: Jobserver | None, weights: dict[str, float]
 ) -> list[Task]:
     by_name = workspace.by_name
     order = [p.name for p in workspace.ordered]
     selected = workspace.selected
+    toolchain = toolchain_digest(base_environment(), options.install_base)
+    fingerprints: dict[str, str | None] = {}
     tasks = []
-    for package in workspace.selected_in_order():
+    for package in workspace.ordered:
+        build_dir = options.build_base / package.name
+        state = read_state(build_dir) if options.use_state else {}
+        if package.name not in selected:
+            fingerprints[package.name] = state.get("fingerprint")  # what is installed, if known
+            continue
         if package.type not in HANDLERS:
             raise TaskError(f"{package.path}: build type '{package.type}' is not supported by roc yet")
         recursive = recursive_dependencies(package, by_name)
         dependencies = [n for n in order if n in recursive]
+        prefix = package_prefix(options.install_base, package.name, options.merge_install)
+        source = (workspace.root / package.path).resolve()
+        fingerprint, files = None, {}
+        if options.use_state:
+            sources, files = source_digest(source, state.get("files", {}))
+            fingerprint = combine({
+                "sources": sources, "options": _options_digest(package, options, prefix), "toolchain": toolchain,
+                "dependencies": {n: fingerprints.get(n) for n in dependencies},
+            })
+            if options.partial():
+                fingerprint = None
+        fingerprints[package.name] = fingerprint
+        up_to_date = (
+            fingerprint is not None and not options.always_rebuild() and state.get("fingerprint") == fingerprint
+            and install_intact(prefix, package.name, build_dir)
+        )
         tasks.append(Task(
             name=package.name,
             dependencies={n for n in dependencies if n in selected},
-            action=_package_action(package, workspace.root, dependencies, options, jobserver),
+            action=_package_action(package, source, prefix, dependencies, options, jobserver, (fingerprint, files)),
             weight=weights.get(package.name, 1.0),
+            up_to_date=up_to_date,
         ))
     return tasks
 
 
-def _package_action(package: Package, root: Path, dependencies: list[str], options: BuildOptions,
-                    jobserver: Jobserver | None):
+def _package_action(package: Package, source: Path, prefix: Path, dependencies: list[str], options: BuildOptions,
+                    jobserver: Jobserver | None, fingerprint_and_files: tuple[str | None, dict]):
+    fingerprint, files = fingerprint_and_files
+
     def action(context: TaskContext) -> None:
         env = build_environment(package, dependencies, options)
-        job = PackageJob(
-            package=package,
-            source=(root / package.path).resolve(),
-            build_dir=options.build_base / package.name,
-            prefix=package_prefix(options.install_base, package.name, options.merge_install),
-        )
-        job.env = env
+        job = PackageJob(package=package, source=source, build_dir=options.build_base / package.name,
+                         prefix=prefix, env=env)
         if jobserver is not None:
             job.make_flags = jobserver.makeflags(env.get("MAKEFLAGS", ""))
             job.pass_fds = jobserver.fds
         job.build_dir.mkdir(parents=True, exist_ok=True)
+        if options.use_state:  # until it succeeds, the package is not up to date
+            write_state(job.build_dir, None, files)
         write_text_atomic(job.build_dir / ENVIRONMENT_FILE, json.dumps(env, indent=1, sort_keys=True))
         HANDLERS[package.type](context, job, options)
         finish_package(package, job.prefix)
+        if options.use_state:
+            write_state(job.build_dir, fingerprint, files)
 
     return action

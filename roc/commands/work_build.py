@@ -42,6 +42,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="enable (+) or disable (-) output: console_start_end, console_stderr, console_direct, "
              "console_cohesion, summary, status, log, event_log, store_result")
     add("--output", choices=("text", "json"), default="text", help="json: one JSON event per line on stdout")
+    add("--force", action="store_true", help="rebuild the selected packages even when they are up to date")
+    add("--no-cache", action="store_true",
+        help="neither skip up-to-date packages nor record fingerprints for the next build")
     cmake = parser.add_argument_group("cmake and ament_cmake packages")
     cmake.add_argument("--cmake-args", action="append", default=[], metavar="ARG",
                        help="arguments for CMake (values may start with '-')")
@@ -115,9 +118,12 @@ def run(args: argparse.Namespace) -> int:
     root = workspace.root
     build_base = (root / args.build_base).absolute()
     install_base = (root / args.install_base).absolute()
-    prepare_build_base(build_base)
-    prepare_install_base(install_base, args.merge_install)
-    return _build(args, workspace, build_base, install_base, switches)
+    from roc.build.lock import build_lock
+
+    with build_lock(build_base):
+        prepare_build_base(build_base)
+        prepare_install_base(install_base, args.merge_install)
+        return _build(args, workspace, build_base, install_base, switches)
 
 
 def _build(args, workspace, build_base: Path, install_base: Path, switches: dict[str, bool]) -> int:
@@ -139,7 +145,8 @@ def _build(args, workspace, build_base: Path, install_base: Path, switches: dict
         ament_cmake_args=tuple(args.ament_cmake_args), cmake_target=args.cmake_target,
         cmake_target_skip_unavailable=args.cmake_target_skip_unavailable,
         cmake_clean_cache=args.cmake_clean_cache, cmake_clean_first=args.cmake_clean_first,
-        cmake_force_configure=args.cmake_force_configure, jobs=jobs,
+        cmake_force_configure=args.cmake_force_configure, jobs=jobs, force=args.force,
+        use_state=not args.no_cache,
     )
     durations = DurationStore(build_base / DURATIONS_FILE)
     jobserver = Jobserver(jobs)

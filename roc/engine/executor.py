@@ -124,6 +124,11 @@ def execute(
             try:
                 while not stopping and ready.has_ready() and len(running) < limit:
                     task = ready.pop()
+                    if task.up_to_date:
+                        event = TaskFinished(task.name, cached=True)
+                        dispatch(event)
+                        settle(event)
+                        continue
                     context = TaskContext(task.name, events.put)
                     running[task.name] = context
                     pool.submit(_work, task, context)

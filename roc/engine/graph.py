@@ -14,7 +14,7 @@ class Task:
     dependencies: set[str]
     action: Callable  # (TaskContext) -> None
     weight: float = 1.0  # expected duration (seconds, or 1.0 when unknown)
-    jobs: int = 1  # compiler jobs it may use at most (informational for the scheduler)
+    up_to_date: bool = False  # finishes as cached without running (and without taking a worker)
 
 
 @dataclass

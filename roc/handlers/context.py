@@ -24,6 +24,15 @@ class BuildOptions:
     cmake_clean_first: bool = False
     cmake_force_configure: bool = False
     jobs: int = 2
+    force: bool = False  # rebuild even when up to date
+    use_state: bool = True  # read and write fingerprints (--no-cache turns it off)
+
+    def partial(self) -> bool:
+        """Builds that do not leave a complete, reusable install (never recorded as up to date)."""
+        return bool(self.cmake_target)
+
+    def always_rebuild(self) -> bool:
+        return self.force or self.cmake_clean_cache or self.cmake_clean_first or self.cmake_force_configure
 
 
 @dataclass

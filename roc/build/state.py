@@ -1,0 +1,49 @@
+"""Per-package build state in ``<build-base>/<pkg>/roc_state.json``: the fingerprint of the last
+successful build and the file stamps that make the next check cheap. Written atomically; a damaged
+file is reported and ignored (the package is rebuilt), never trusted."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from roc.fsutil import write_text_atomic
+from roc.workspace.identify import warn
+
+STATE_FILE = "roc_state.json"
+
+
+def read_state(build_dir: Path) -> dict:
+    path = build_dir / STATE_FILE
+    try:
+        state = json.loads(path.read_text())
+    except FileNotFoundError:
+        return {}
+    except (OSError, ValueError):
+        warn(f"{path}: damaged build state; the package will be rebuilt")
+        return {}
+    if not isinstance(state, dict) or not isinstance(state.get("files", {}), dict):
+        warn(f"{path}: damaged build state; the package will be rebuilt")
+        return {}
+    return state
+
+
+def write_state(build_dir: Path, fingerprint: str | None, files: dict) -> None:
+    """Record ``fingerprint`` as built (None: not up to date, e.g. before a build starts)."""
+    state = {"fingerprint": fingerprint, "files": files}
+    write_text_atomic(build_dir / STATE_FILE, json.dumps(state, separators=(",", ":")))
+
+
+def install_intact(prefix: Path, name: str, build_dir: Path) -> bool:
+    """The package's install markers and every file its last install recorded still exist."""
+    if not (prefix / "share" / "colcon-core" / "packages" / name).is_file():
+        return False
+    if not (prefix / "share" / name / "package.dsv").is_file():
+        return False
+    for manifest in ("install_manifest.txt", "install.log"):
+        path = build_dir / manifest
+        if path.is_file():
+            for line in path.read_text().splitlines():
+                if line and not line.endswith(".pyc") and not Path(line).exists() and not Path(line).is_symlink():
+                    return False
+    return True
