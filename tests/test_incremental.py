@@ -1,0 +1,121 @@
+"""Incremental builds: what a change rebuilds, read from the events roc logged (no tool runs for an
+up-to-date package)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+
+import pytest
+
+from build_helpers import BIN, copy_fixture, in_sourced_shell, ros_env, roc
+
+pytestmark = pytest.mark.slow
+
+
+def _events(ws) -> list[dict]:
+    return [json.loads(line) for line in (ws / "log" / "latest_build" / "events.log").read_text().splitlines()]
+
+
+def _built(ws) -> set[str]:
+    """Packages whose tools ran in the last build."""
+    return {e["task"] for e in _events(ws) if e["event"] == "CommandStarted"}
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    ws = copy_fixture("build_small", tmp_path_factory.mktemp("inc") / "ws")
+    result = roc("work", "build", cwd=ws)
+    assert result.returncode == 0, result.stdout + result.stderr
+    return ws
+
+
+def test_noop_rebuild_runs_no_tool(built):
+    result = roc("work", "build", cwd=built)
+    assert result.returncode == 0
+    assert _built(built) == set()
+    assert "4 packages up to date (not rebuilt)" in result.stdout
+    assert "Starting >>>" not in result.stdout
+
+
+def test_edit_rebuilds_the_package_and_its_dependents_only(built):
+    source = built / "src" / "core" / "src" / "core.cpp"
+    original = source.read_text()
+    source.write_text(original.replace("42", "43"))
+    try:
+        assert roc("work", "build", cwd=built).returncode == 0
+        assert _built(built) == {"core", "app", "pyp"}  # pyp depends on core (exec_depend)
+        assert "core says 43" in in_sourced_shell(built, "install/app/lib/app/app").stdout
+    finally:
+        source.write_text(original)
+    assert roc("work", "build", cwd=built).returncode == 0
+    assert _built(built) == {"core", "app", "pyp"}  # back to the old content: a new build of it
+    source.touch()  # a new mtime with the same content changes nothing
+    assert roc("work", "build", cwd=built).returncode == 0
+    assert _built(built) == set()
+
+
+def test_cmake_args_rebuild_the_cmake_packages_and_their_dependents(built):
+    assert roc("work", "build", "--cmake-args", "-DROC_TEST_OPTION=1", cwd=built).returncode == 0
+    assert _built(built) == {"core", "app", "plain", "pyp"}
+    assert roc("work", "build", "--cmake-args", "-DROC_TEST_OPTION=1", cwd=built).returncode == 0
+    assert _built(built) == set()
+    assert roc("work", "build", cwd=built).returncode == 0  # back to no arguments
+    assert _built(built) == {"core", "app", "plain", "pyp"}
+
+
+def test_deleted_install_or_build_directory_rebuilds(built):
+    shutil.rmtree(built / "install" / "plain")
+    assert roc("work", "build", cwd=built).returncode == 0
+    assert _built(built) == {"plain"}
+    assert in_sourced_shell(built, "plain").stdout.strip() == "plain ok"
+    shutil.rmtree(built / "build" / "app")
+    assert roc("work", "build", cwd=built).returncode == 0
+    assert _built(built) == {"app"}
+
+
+def test_damaged_state_rebuilds_with_a_warning(built):
+    state = built / "build" / "plain" / "roc_state.json"
+    state.write_text(state.read_text()[: len(state.read_text()) // 2])
+    result = roc("work", "build", cwd=built)
+    assert result.returncode == 0
+    assert "damaged build state" in result.stderr and "plain" in result.stderr
+    assert _built(built) == {"plain"}
+
+
+def test_failed_build_is_never_up_to_date(built):
+    cmakelists = built / "src" / "plain" / "CMakeLists.txt"
+    original = cmakelists.read_text()
+    cmakelists.write_text(original + "\nmessage(FATAL_ERROR broken)\n")
+    try:
+        assert roc("work", "build", cwd=built).returncode == 1
+    finally:
+        cmakelists.write_text(original)
+    assert roc("work", "build", cwd=built).returncode == 0
+    assert _built(built) == {"plain"}
+
+
+def test_force_and_no_cache(built):
+    assert roc("work", "build", "--force", "--packages-select", "plain", cwd=built).returncode == 0
+    assert _built(built) == {"plain"}
+    state = built / "build" / "plain" / "roc_state.json"
+    before = state.read_text()
+    assert roc("work", "build", "--no-cache", "--packages-select", "plain", cwd=built).returncode == 0
+    assert _built(built) == {"plain"} and state.read_text() == before
+
+
+def test_concurrent_builds_wait_for_each_other(tmp_path):
+    ws = copy_fixture("build_small", tmp_path / "ws")
+    command = [str(BIN / "roc"), "work", "build", "--packages-up-to", "app"]
+    first = subprocess.Popen(command, cwd=ws, env=ros_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        second = subprocess.run(command, cwd=ws, env=ros_env(), capture_output=True, text=True, timeout=300)
+        first_out, _ = first.communicate(timeout=300)
+    finally:
+        if first.poll() is None:
+            first.kill()
+    assert first.returncode == 0 and second.returncode == 0
+    assert "waiting for it to finish" in second.stderr
+    assert "2 packages up to date" in second.stdout  # the second found the first's results
+    assert "core says 42" in in_sourced_shell(ws, "install/app/lib/app/app").stdout
