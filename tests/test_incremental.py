@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import shutil
 import subprocess
+import time
 
 import pytest
 
@@ -109,7 +110,11 @@ def test_concurrent_builds_wait_for_each_other(tmp_path):
     ws = copy_fixture("build_small", tmp_path / "ws")
     command = [str(BIN / "roc"), "work", "build", "--packages-up-to", "app"]
     first = subprocess.Popen(command, cwd=ws, env=ros_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    lock = ws / "build" / ".roc_lock"
     try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and not (lock.exists() and f"pid {first.pid}" in lock.read_text()):
+            time.sleep(0.05)
         second = subprocess.run(command, cwd=ws, env=ros_env(), capture_output=True, text=True, timeout=300)
         first_out, _ = first.communicate(timeout=300)
     finally:

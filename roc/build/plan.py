@@ -6,7 +6,7 @@ import json
 import os
 import sys
 from pathlib import Path
-from typing import Callable
+from collections.abc import Callable
 
 from roc.build.finish import finish_package
 from roc.build.fingerprint import combine, source_digest, toolchain_digest

@@ -8,7 +8,7 @@ import json
 from pathlib import Path
 
 from roc.fsutil import write_text_atomic
-from roc.workspace.identify import warn
+from roc.messages import warn
 
 STATE_FILE = "roc_state.json"
 

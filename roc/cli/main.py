@@ -35,7 +35,29 @@ class Parser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
 
 
-def build_parser() -> Parser:
+def _requested_command(argv: list[str]) -> tuple[str, ...]:
+    """The command path named on the command line (aliases resolved), e.g. ("work", "list")."""
+    path: tuple[str, ...] = ()
+    words = iter(argv)
+    for word in words:
+        if word == "-C":
+            next(words, None)
+            continue
+        if word.startswith("-"):
+            continue
+        for command, aliases, _, _ in COMMANDS:
+            if command[:-1] == path and word in (command[-1], *aliases):
+                path = command
+                break
+        else:
+            break
+    return path
+
+
+def build_parser(argv: list[str] | None = None) -> Parser:
+    """The argument parser; with ``argv`` only the named command's options are set up (every command
+    is still listed), which keeps start-up short."""
+    wanted = _requested_command(argv) if argv is not None else None
     parser = Parser(prog="roc", description="roc: fast, dependable tools for ROS 2 workspaces.")
     parser.add_argument("--version", action="version", version=f"roc {__version__}")
     parser.add_argument("--debug", action="store_true", help="show Python tracebacks for errors")
@@ -49,7 +71,8 @@ def build_parser() -> Parser:
             groups[path] = sub.add_subparsers(dest="_".join(path) + "_command", metavar="COMMAND", parser_class=Parser)
             sub.set_defaults(_group=sub)
         else:
-            _command_module(module).add_arguments(sub)
+            if wanted is None or wanted == path:
+                _command_module(module).add_arguments(sub)
             sub.set_defaults(_module=module, _group=None)
     return parser
 
@@ -61,8 +84,8 @@ def _command_module(name: str):
 def main(argv: list[str] | None = None) -> int:
     debug = os.environ.get("ROC_DEBUG") == "1" or "--debug" in (argv if argv is not None else sys.argv[1:])
     try:
-        parser = build_parser()
         argv = list(sys.argv[1:] if argv is None else argv)
+        parser = build_parser(argv)
         if any(token in argv for token in ("--cmake-args", "--ament-cmake-args")):
             from roc.commands.completion import all_options
             from roc.commands.work_build import rewrite_passthrough

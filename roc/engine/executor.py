@@ -12,7 +12,7 @@ import time
 import traceback
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
-from typing import Callable, Iterable
+from collections.abc import Callable, Iterable
 
 from roc.engine.events import (
     Event, RunFinished, TaskAborted as TaskAbortedEvent, TaskFailed, TaskFinished, TaskQueued, TaskSkipped,

@@ -6,7 +6,7 @@ import os
 import selectors
 import subprocess
 import threading
-from typing import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 from roc.engine.events import CommandEnded, CommandStarted, Event, TaskOutput
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import MutableMapping
+from collections.abc import MutableMapping
 
 PREPEND_TYPES = ("prepend-non-duplicate", "prepend-non-duplicate-if-exists")
 APPEND_TYPES = ("append-non-duplicate",)

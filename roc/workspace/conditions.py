@@ -7,7 +7,7 @@ literals, combined with ``and``/``or`` and parentheses. An unset variable is the
 from __future__ import annotations
 
 import re
-from typing import Mapping
+from collections.abc import Mapping
 
 # ROS 2 defaults, used when the environment does not set them (e.g. a Python venv with the ROS
 # wheels, where no setup script has exported them).

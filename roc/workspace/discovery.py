@@ -10,7 +10,7 @@ from __future__ import annotations
 import glob
 import os
 from pathlib import Path
-from typing import Iterable, Mapping
+from collections.abc import Iterable, Mapping
 
 from roc.errors import UsageError, RocError
 from roc.workspace.identify import SkipLocation, identify
@@ -35,8 +35,12 @@ def discover_packages(
     variables: Mapping[str, str],
     base_paths: list[str] | None = None,
     paths: list[str] | None = None,
+    visited: list[str] | None = None,
 ) -> list[Package]:
-    """All packages below ``root`` (relative base paths and paths are taken from ``root``)."""
+    """All packages below ``root`` (relative base paths and paths are taken from ``root``).
+
+    ``visited`` collects every directory looked at (for the discovery cache)."""
+    visited = [] if visited is None else visited
     if base_paths is None and paths is None:
         base_paths = ["."]
     found: dict[str, Package] = {}  # real path -> package
@@ -45,12 +49,13 @@ def discover_packages(
         start = root / base
         if not start.is_dir():
             raise UsageError(f"--base-paths: '{base}' is not a directory")
-        _crawl(start, Path(base), variables, found)
+        _crawl(start, Path(base), variables, found, visited)
     for given in _expand(paths or [], root):
         directory = root / given
         if not directory.is_dir():
             raise UsageError(f"--paths: '{given}' is not a directory")
         real = os.path.realpath(directory)
+        visited.append(str(directory))
         if real in found:
             continue
         try:
@@ -66,14 +71,15 @@ def discover_packages(
     return packages
 
 
-def _crawl(start: Path, shown_base: Path, variables, found: dict[str, Package]) -> None:
-    visited: set[str] = set()
+def _crawl(start: Path, shown_base: Path, variables, found: dict[str, Package], visited: list[str]) -> None:
+    seen: set[str] = set()
     for dirpath, dirnames, filenames in os.walk(start, followlinks=True):
         real = os.path.realpath(dirpath)
-        if real in visited or real in found:
+        if real in seen or real in found:
             dirnames.clear()
             continue
-        visited.add(real)
+        seen.add(real)
+        visited.append(dirpath)
         shown = shown_base / os.path.relpath(dirpath, start)
         try:
             package = identify(Path(dirpath), shown, set(filenames), variables)

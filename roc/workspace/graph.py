@@ -9,7 +9,7 @@ direct ones), so the stdlib's ``graphlib`` does it without the cost of importing
 from __future__ import annotations
 
 from graphlib import CycleError, TopologicalSorter
-from typing import Iterable
+from collections.abc import Iterable
 
 from roc.errors import RocError
 from roc.workspace.package import CATEGORIES, Package

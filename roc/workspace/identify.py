@@ -13,11 +13,11 @@
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
-from typing import Mapping
+from collections.abc import Mapping
 
 from roc.errors import ManifestError
+from roc.messages import warn
 from roc.workspace.cmake_project import read_cmake_project
 from roc.workspace.manifest import parse_manifest
 from roc.workspace.package import CATEGORIES, Package
@@ -30,10 +30,6 @@ INSTALL_SPACE_FILES = ("_setup_util.py", "_order_isolated_packages.py")
 
 class SkipLocation(Exception):
     """This directory and everything below it is not to be crawled."""
-
-
-def warn(message: str) -> None:
-    print(f"roc: warning: {message}", file=sys.stderr)
 
 
 def identify(directory: Path, shown_path: Path, filenames: set[str], variables: Mapping[str, str]) -> Package | None:

@@ -5,22 +5,21 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from roc.workspace.conditions import condition_environment
-from roc.workspace.discovery import discover_packages
+from roc.workspace.cache import cached_discovery
 from roc.workspace.graph import topological_order
 from roc.workspace.package import Package
 from roc.workspace.root import find_workspace_root
 from roc.workspace.selection import check_selection_arguments, ignore_packages, select_packages
 
 
-@dataclass
 class Workspace:
-    root: Path
-    ordered: list[Package]  # every package not ignored, in topological order
-    selected: set[str] = field(default_factory=set)
+    def __init__(self, root: Path, ordered: list[Package], selected: set[str]):
+        self.root = root
+        self.ordered = ordered  # every package not ignored, in topological order
+        self.selected = selected
 
     @property
     def by_name(self) -> dict[str, Package]:
@@ -49,7 +48,14 @@ def find_workspace_root_for(args: argparse.Namespace) -> Path:
 
 def load_workspace(args: argparse.Namespace) -> Workspace:
     root = resolve_root(args)
-    packages = discover_packages(root, condition_environment(os.environ), args.base_paths, args.paths)
+    variables = condition_environment(os.environ)
+
+    def discover(visited: list[str]) -> list[Package]:
+        from roc.workspace.discovery import discover_packages
+
+        return discover_packages(root, variables, args.base_paths, args.paths, visited)
+
+    packages = cached_discovery(root, variables, args.base_paths, args.paths, discover)
     check_selection_arguments(args, {p.name for p in packages})
     ordered = topological_order(ignore_packages(args, packages))
     build_base = root / getattr(args, "build_base", "build")

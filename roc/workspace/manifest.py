@@ -6,9 +6,10 @@ dependencies that apply to the current environment, as colcon does.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import re
+from collections import namedtuple
 from pathlib import Path
-from typing import Mapping
+from collections.abc import Mapping
 
 from roc.errors import ManifestError
 from roc.workspace.conditions import ConditionError, evaluate_condition
@@ -34,29 +35,48 @@ CATEGORY_TAGS = {
 }
 
 
-@dataclass(frozen=True)
-class Dependency:
-    name: str
-    tag: str  # the tag as written (``depend``, ``run_depend``, ...)
-    versions: tuple[tuple[str, str], ...] = ()  # (attribute, value), e.g. ("version_gte", "1.2")
-    condition: str | None = None
+# ``tag`` as written (``depend``, ``run_depend``, ...); ``versions``: (attribute, value) pairs such as
+# ("version_gte", "1.2").
+Dependency = namedtuple("Dependency", "name tag versions condition", defaults=((), None))
 
 
-@dataclass
 class Manifest:
-    path: Path
-    format: int
-    name: str
-    version: str
-    description: str = ""
-    maintainers: list[str] = field(default_factory=list)  # "Name <email>"
-    authors: list[str] = field(default_factory=list)
-    licenses: list[str] = field(default_factory=list)
-    urls: list[tuple[str, str]] = field(default_factory=list)  # (type, url)
-    build_type: str = "catkin"
-    dependencies: list[Dependency] = field(default_factory=list)  # only those whose condition holds
-    group_depends: list[str] = field(default_factory=list)
-    member_of_groups: list[str] = field(default_factory=list)
+    """A parsed package.xml (a plain class: see roc.workspace.package)."""
+
+    FIELDS = ("path", "format", "name", "version", "description", "maintainers", "authors", "licenses", "urls",
+              "build_type", "dependencies", "group_depends", "member_of_groups", "condition_variables")
+
+    def __init__(self, path: Path, format: int, name: str, version: str, description: str = "",  # noqa: A002
+                 build_type: str = "catkin", **lists):
+        self.path = path
+        self.format = format
+        self.name = name
+        self.version = version
+        self.description = description
+        self.build_type = build_type
+        self.maintainers: list[str] = lists.pop("maintainers", [])  # "Name <email>"
+        self.authors: list[str] = lists.pop("authors", [])
+        self.licenses: list[str] = lists.pop("licenses", [])
+        self.urls: list[tuple[str, str]] = lists.pop("urls", [])  # (type, url)
+        self.dependencies: list[Dependency] = lists.pop("dependencies", [])  # only those whose condition holds
+        self.group_depends: list[str] = lists.pop("group_depends", [])
+        self.member_of_groups: list[str] = lists.pop("member_of_groups", [])
+        self.condition_variables: list[str] = lists.pop("condition_variables", [])  # $NAMEs conditions read
+        if lists:
+            raise TypeError(f"unknown manifest fields: {', '.join(lists)}")
+
+    def to_dict(self) -> dict:
+        data = {f: getattr(self, f) for f in self.FIELDS}
+        data["path"] = str(self.path)
+        data["dependencies"] = [[d.name, d.tag, [list(v) for v in d.versions], d.condition] for d in self.dependencies]
+        return data
+
+    @classmethod
+    def from_dict(cls, data: dict) -> Manifest:
+        values = dict(data, path=Path(data["path"]), urls=[tuple(u) for u in data["urls"]])
+        values["dependencies"] = [Dependency(name, tag, tuple(tuple(v) for v in versions), condition)
+                                  for name, tag, versions, condition in data["dependencies"]]
+        return cls(**values)
 
     def dependencies_by_tag(self, tag: str) -> list[Dependency]:
         """Dependencies of an expanded tag list (``depend`` counts as build, build_export and exec)."""
@@ -89,11 +109,15 @@ class _ManifestReader:
         self.path = path
         self.root = root
         self.variables = variables
+        self.variables_read: set[str] = set()
 
     def error(self, message: str, element=None) -> ManifestError:
         return ManifestError(str(self.path), message, (element if element is not None else self.root).sourceline)
 
     def holds(self, element) -> bool:
+        condition = element.get("condition")
+        if condition:
+            self.variables_read.update(re.findall(r"\$(\w+)", condition))
         try:
             return evaluate_condition(element.get("condition"), self.variables)
         except ConditionError as error:
@@ -153,6 +177,7 @@ class _ManifestReader:
                 versions = tuple((a, element.get(a)) for a in VERSION_ATTRIBUTES if element.get(a) is not None)
                 manifest.dependencies.append(Dependency(name, tag, versions, element.get("condition")))
         manifest.build_type = self._build_type()
+        manifest.condition_variables = sorted(self.variables_read)
         return manifest
 
     def _build_type(self) -> str:

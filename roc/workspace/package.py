@@ -1,38 +1,60 @@
-"""The package descriptor shared by every verb."""
+"""The package descriptor shared by every verb.
+
+A plain class rather than a dataclass: importing dataclasses costs more than listing a workspace
+from the discovery cache.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from roc.workspace.manifest import Manifest
 
 CATEGORIES = ("build", "run", "test")
 
 
-@dataclass(eq=False)
 class Package:
     """One package found in a workspace.
 
     ``path`` is as colcon prints it: the base path joined with the package's directory below it.
     ``dependencies`` maps each category (build, run, test) to the names of the packages depended on;
-    names outside the workspace are kept (they are satisfied by underlays).
+    names outside the workspace are kept (they are satisfied by underlays). Only the categories the
+    package's kind defines are present (colcon info prints them). ``constraints`` holds version
+    constraints of dependencies, e.g. {"rclpy": {"version_gte": "3.0"}}; ``manifest`` the parsed
+    package.xml of ROS packages.
     """
 
-    name: str
-    path: Path
-    type: str  # ros.ament_cmake, ros.ament_python, ros.cmake, ros.catkin, cmake, python, ...
-    # Only the categories the package's kind defines are present (colcon info prints them).
-    dependencies: dict[str, set[str]] = field(default_factory=dict)
-    hooks: list[str] = field(default_factory=list)
-    metadata: dict[str, object] = field(default_factory=dict)
-    # Version constraints of dependencies, e.g. {"rclpy": {"version_gte": "3.0"}}.
-    constraints: dict[str, dict[str, str]] = field(default_factory=dict)
-    group_depends: list[str] = field(default_factory=list)
-    member_of_groups: list[str] = field(default_factory=list)
-    manifest: Manifest | None = None  # the parsed package.xml of ROS packages
+    def __init__(
+        self, name: str, path: Path, type: str, dependencies: dict[str, set[str]] | None = None,  # noqa: A002
+        hooks: list[str] | None = None, metadata: dict[str, object] | None = None,
+        constraints: dict[str, dict[str, str]] | None = None, group_depends: list[str] | None = None,
+        member_of_groups: list[str] | None = None, manifest: Manifest | None = None,
+    ):
+        self.name = name
+        self.path = path
+        self.type = type  # ros.ament_cmake, ros.ament_python, ros.cmake, ros.catkin, cmake, python, ...
+        self.dependencies = dependencies if dependencies is not None else {}
+        self.hooks = hooks if hooks is not None else []
+        self.metadata = metadata if metadata is not None else {}
+        self.constraints = constraints if constraints is not None else {}
+        self.group_depends = group_depends if group_depends is not None else []
+        self.member_of_groups = member_of_groups if member_of_groups is not None else []
+        self._manifest = manifest
+        self._manifest_data: dict | None = None  # from the cache, decoded on first use
+
+    @property
+    def manifest(self) -> Manifest | None:
+        if self._manifest is None and self._manifest_data is not None:
+            from roc.workspace.manifest import Manifest
+
+            self._manifest = Manifest.from_dict(self._manifest_data)
+            self._manifest_data = None
+        return self._manifest
+
+    @manifest.setter
+    def manifest(self, value: Manifest | None) -> None:
+        self._manifest, self._manifest_data = value, None
+
+    def __repr__(self) -> str:
+        return f"Package({self.name!r}, {str(self.path)!r}, {self.type!r})"
 
     def direct_dependencies(self, categories=CATEGORIES) -> set[str]:
         names: set[str] = set()
@@ -40,6 +62,27 @@ class Package:
             names |= self.dependencies.get(category, set())
         names.discard(self.name)
         return names
+
+    def to_dict(self) -> dict:
+        """A JSON-ready form (for the discovery cache)."""
+        return {
+            "name": self.name, "path": str(self.path), "type": self.type,
+            "dependencies": {c: sorted(names) for c, names in self.dependencies.items()},
+            "hooks": self.hooks, "metadata": self.metadata, "constraints": self.constraints,
+            "group_depends": self.group_depends, "member_of_groups": self.member_of_groups,
+            "manifest": self.manifest.to_dict() if self.manifest else None,
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict) -> Package:
+        package = cls(
+            name=data["name"], path=Path(data["path"]), type=data["type"],
+            dependencies={c: set(names) for c, names in data["dependencies"].items()},
+            hooks=data["hooks"], metadata=data["metadata"], constraints=data["constraints"],
+            group_depends=data["group_depends"], member_of_groups=data["member_of_groups"],
+        )
+        package._manifest_data = data["manifest"]
+        return package
 
     @property
     def build_type(self) -> str:

@@ -10,11 +10,11 @@ import argparse
 import difflib
 import re
 from pathlib import Path
-from typing import Callable, Iterable
+from collections.abc import Callable, Iterable
 
 from roc.errors import UsageError
 from roc.workspace.graph import recursive_dependencies
-from roc.workspace.identify import warn
+from roc.messages import warn
 from roc.workspace.package import Package
 
 # Options that take package names, checked against the workspace.

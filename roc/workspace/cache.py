@@ -1,0 +1,103 @@
+"""A cache of discovery results, so that planning a large workspace takes milliseconds.
+
+Stored in the user's cache directory (``$ROC_CACHE_DIR``, else ``$XDG_CACHE_HOME/roc``, else
+``~/.cache/roc``), one file per workspace root and discovery options. It is valid while every
+directory the crawl looked at and every file identification read has the same mtime (and size), and
+the variables that conditions read have the same values; anything else means a fresh discovery.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import zlib
+from pathlib import Path
+from collections.abc import Callable, Mapping
+
+from roc import __version__, messages
+from roc.fsutil import write_text_atomic
+from roc.workspace.package import Package
+
+IDENTIFICATION_FILES = ("package.xml", "setup.py", "setup.cfg", "colcon.pkg", "CMakeLists.txt", "manifest.xml")
+
+
+def cache_directory() -> Path:
+    if os.environ.get("ROC_CACHE_DIR"):
+        return Path(os.environ["ROC_CACHE_DIR"])
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "roc"
+
+
+def _cache_key(root: Path, base_paths, paths) -> str:
+    return json.dumps([__version__, str(root), base_paths, paths])
+
+
+def _cache_path(key: str) -> Path:
+    # crc32 only names the file (cheaper to import than hashlib); the full key inside is checked.
+    return cache_directory() / f"discovery-{zlib.crc32(key.encode()):08x}.json"
+
+
+def _stamp(path: str) -> list[int] | None:
+    try:
+        info = os.stat(path)
+    except OSError:
+        return None
+    return [info.st_mtime_ns, info.st_size]
+
+
+def _inputs(root: Path, visited: list[str], packages: list[Package]) -> dict[str, list[int] | None]:
+    """Every directory and file whose change could change what discovery finds."""
+    inputs = {directory: _stamp(directory) for directory in visited}
+    for package in packages:
+        directory = str(root / package.path)
+        inputs[directory] = _stamp(directory)
+        for name in IDENTIFICATION_FILES:
+            path = os.path.join(directory, name)
+            if os.path.exists(path):
+                inputs[path] = _stamp(path)
+        if package.type == "cmake":  # dependencies come from every CMake file below it
+            for dirpath, dirnames, filenames in os.walk(directory):
+                dirnames[:] = [d for d in dirnames if not d.startswith(".")]
+                inputs[dirpath] = _stamp(dirpath)
+                for name in filenames:
+                    if name == "CMakeLists.txt" or name.endswith(".cmake"):
+                        inputs[os.path.join(dirpath, name)] = _stamp(os.path.join(dirpath, name))
+    return inputs
+
+
+def _condition_variables(packages: list[Package]) -> list[str]:
+    return sorted({n for p in packages if p.manifest for n in p.manifest.condition_variables})
+
+
+def cached_discovery(
+    root: Path, variables: Mapping[str, str], base_paths, paths,
+    discover: Callable[[list[str]], list[Package]],
+) -> list[Package]:
+    """The packages ``discover(visited)`` finds, from the cache when nothing they came from changed."""
+    key = _cache_key(root, base_paths, paths)
+    path = _cache_path(key)
+    try:
+        data = json.loads(path.read_text())
+        if data["key"] == key and all(_stamp(p) == stamp for p, stamp in data["inputs"].items()):
+            if all(variables.get(name) == value for name, value in data["conditions"].items()):
+                packages = [Package.from_dict(item) for item in data["packages"]]
+                for warning in data["warnings"]:
+                    messages.warn(warning)
+                return packages
+    except (OSError, ValueError, KeyError, TypeError):
+        pass  # no cache yet, or one from another roc version: discover
+    first_warning = len(messages.emitted)
+    visited: list[str] = []
+    packages = discover(visited)
+    data = {
+        "key": key,
+        "inputs": _inputs(root, visited, packages),
+        "conditions": {name: variables.get(name) for name in _condition_variables(packages)},
+        "warnings": messages.emitted[first_warning:],
+        "packages": [p.to_dict() for p in packages],
+    }
+    try:
+        write_text_atomic(path, json.dumps(data, separators=(",", ":")))
+    except OSError:
+        pass  # a read-only home: work without the cache
+    return packages
