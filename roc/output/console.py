@@ -104,7 +104,8 @@ class ConsoleHandler:
         total = format_duration(time.monotonic() - self.started_at)
         lines = ["", f"Summary: {_count(len(self.finished) + len(self.cached))} finished [{total}]"]
         if self.cached:
-            lines.append(f"  {_count(len(self.cached))} up to date (not rebuilt): {' '.join(sorted(self.cached))}")
+            names = f": {' '.join(sorted(self.cached))}" if len(self.cached) <= 10 else ""
+            lines.append(f"  {_count(len(self.cached))} up to date (not rebuilt){names}")
         if self.failed:
             lines.append(f"  {_count(len(self.failed))} failed: {' '.join(sorted(self.failed))}")
         if self.aborted:
