@@ -65,17 +65,48 @@ def saved_environment(build_base: Path, name: str) -> dict[str, str] | None:
     return json.loads(path.read_text()) if path.is_file() else None
 
 
-def _options_digest(package: Package, options: BuildOptions, prefix: Path) -> dict:
-    """The options that shape this package's build."""
+def _options_digest(package: Package, options: BuildOptions) -> dict:
+    """The options that shape this package's build (no absolute paths: a restored cache may live in
+    another directory)."""
     cmake_based = package.build_type in ("cmake", "ament_cmake")
     return {
         "type": package.type,
-        "prefix": str(prefix),
         "merge": options.merge_install,
         "symlink": options.symlink_install,
         "cmake_args": list(options.cmake_args) if cmake_based else [],
         "ament_cmake_args": list(options.ament_cmake_args) if package.build_type == "ament_cmake" else [],
     }
+
+
+class PackageState:
+    """What planning knows of one selected package: its fingerprint now, the one of its last
+    successful build, and the file stamps to store after building it."""
+
+    def __init__(self, fingerprint: str | None, stored: str | None, files: dict):
+        self.fingerprint, self.stored, self.files = fingerprint, stored, files
+
+
+def fingerprint_packages(workspace: Workspace, options: BuildOptions) -> dict[str, PackageState]:
+    """Fingerprints of the selected packages, in topological order. A package that is not selected
+    counts with the fingerprint of its last successful build (what is installed), if known."""
+    by_name = workspace.by_name
+    toolchain = toolchain_digest(base_environment(), options.install_base)
+    fingerprints: dict[str, str | None] = {}
+    states: dict[str, PackageState] = {}
+    for package in workspace.ordered:
+        state = read_state(options.build_base / package.name)
+        if package.name not in workspace.selected:
+            fingerprints[package.name] = state.get("fingerprint")
+            continue
+        sources, files = source_digest((workspace.root / package.path).resolve(), state.get("files", {}))
+        recursive = recursive_dependencies(package, by_name)
+        fingerprint = combine({
+            "sources": sources, "options": _options_digest(package, options), "toolchain": toolchain,
+            "dependencies": {n: fingerprints.get(n) for n in sorted(recursive)},
+        })
+        fingerprints[package.name] = fingerprint
+        states[package.name] = PackageState(fingerprint, state.get("fingerprint"), files)
+    return states
 
 
 def plan_build(
@@ -84,39 +115,26 @@ def plan_build(
     by_name = workspace.by_name
     order = [p.name for p in workspace.ordered]
     selected = workspace.selected
-    toolchain = toolchain_digest(base_environment(), options.install_base)
-    fingerprints: dict[str, str | None] = {}
+    states = fingerprint_packages(workspace, options) if options.use_state else {}
     tasks = []
-    for package in workspace.ordered:
-        build_dir = options.build_base / package.name
-        state = read_state(build_dir) if options.use_state else {}
-        if package.name not in selected:
-            fingerprints[package.name] = state.get("fingerprint")  # what is installed, if known
-            continue
+    for package in workspace.selected_in_order():
         if package.type not in HANDLERS:
             raise TaskError(f"{package.path}: build type '{package.type}' is not supported by roc yet")
         recursive = recursive_dependencies(package, by_name)
         dependencies = [n for n in order if n in recursive]
         prefix = package_prefix(options.install_base, package.name, options.merge_install)
         source = (workspace.root / package.path).resolve()
-        fingerprint, files = None, {}
-        if options.use_state:
-            sources, files = source_digest(source, state.get("files", {}))
-            fingerprint = combine({
-                "sources": sources, "options": _options_digest(package, options, prefix), "toolchain": toolchain,
-                "dependencies": {n: fingerprints.get(n) for n in dependencies},
-            })
-            if options.partial():
-                fingerprint = None
-        fingerprints[package.name] = fingerprint
+        state = states.get(package.name, PackageState(None, None, {}))
+        fingerprint = None if options.partial() else state.fingerprint
         up_to_date = (
-            fingerprint is not None and not options.always_rebuild() and state.get("fingerprint") == fingerprint
-            and install_intact(prefix, package.name, build_dir)
+            fingerprint is not None and not options.always_rebuild() and state.stored == fingerprint
+            and install_intact(prefix, package.name, options.build_base / package.name)
         )
         tasks.append(Task(
             name=package.name,
             dependencies={n for n in dependencies if n in selected},
-            action=_package_action(package, source, prefix, dependencies, options, jobserver, (fingerprint, files)),
+            action=_package_action(package, source, prefix, dependencies, options, jobserver,
+                                   (fingerprint, state.files)),
             weight=weights.get(package.name, 1.0),
             up_to_date=up_to_date,
         ))

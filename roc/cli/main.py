@@ -23,6 +23,7 @@ COMMANDS = (
     (("work", "graph"), (), "work_graph", "show the dependency graph (like colcon graph)"),
     (("work", "build"), ("b",), "work_build", "build the workspace (a drop-in for colcon build)"),
     (("work", "env"), (), "work_env", "print a package's build environment, or run a command in it"),
+    (("work", "cache"), (), "work_cache", "CI caching of build results: cache key | export PATH | import PATH"),
     (("work", "create"), (), "work_create", "create a new package from a template (like ros2 pkg create)"),
     (("completion",), (), "completion", "print a shell completion script: bash, zsh or fish"),
 )

@@ -25,11 +25,8 @@ DURATIONS_FILE = "roc_durations.json"
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     add = parser.add_argument
     add("packages", nargs="*", metavar="PKG_NAME", help="shorthand for --packages-up-to PKG_NAME...")
-    add("--build-base", default="build", help="base directory of the build directories (default: build)")
-    add("--install-base", default="install", help="base directory of the install prefixes (default: install)")
+    add_layout_arguments(parser)
     add("--log-base", default="log", help="base directory of the logs, or /dev/null for none (default: log)")
-    add("--merge-install", action="store_true", help="install all packages into one prefix")
-    add("--symlink-install", action="store_true", help="symlink installed files to the sources where possible")
     add("--continue-on-error", action="store_true",
         help="keep building packages that do not depend on a failed one (default: stop at the first failure)")
     add("--executor", choices=("parallel", "sequential"), default="parallel", help="run packages in parallel "
@@ -46,16 +43,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add("--no-cache", action="store_true",
         help="neither skip up-to-date packages nor record fingerprints for the next build")
     cmake = parser.add_argument_group("cmake and ament_cmake packages")
-    cmake.add_argument("--cmake-args", action="append", default=[], metavar="ARG",
-                       help="arguments for CMake (values may start with '-')")
     cmake.add_argument("--cmake-target", help="build this target instead of the default one (no install)")
     cmake.add_argument("--cmake-target-skip-unavailable", action="store_true",
                        help="skip packages that do not have the --cmake-target")
     cmake.add_argument("--cmake-clean-cache", action="store_true", help="remove the CMake cache first")
     cmake.add_argument("--cmake-clean-first", action="store_true", help="build target 'clean' first")
     cmake.add_argument("--cmake-force-configure", action="store_true", help="always run the CMake configure step")
-    cmake.add_argument("--ament-cmake-args", action="append", default=[], metavar="ARG",
-                       help="arguments for ament_cmake packages only")
     unsupported = parser.add_argument_group("colcon options roc does not support yet (rejected if used)")
     unsupported.add_argument("--test-result-base", help=argparse.SUPPRESS)
     unsupported.add_argument("--metas", nargs="*", help=argparse.SUPPRESS)
@@ -64,6 +57,28 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     unsupported.add_argument("--catkin-skip-building-tests", action="store_true", default=None,
                              help=argparse.SUPPRESS)
     add_selection_arguments(parser)
+
+
+def add_layout_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options that decide where packages go and what their fingerprints are (build and cache)."""
+    add = parser.add_argument
+    add("--build-base", default="build", help="base directory of the build directories (default: build)")
+    add("--install-base", default="install", help="base directory of the install prefixes (default: install)")
+    add("--merge-install", action="store_true", help="install all packages into one prefix")
+    add("--symlink-install", action="store_true", help="symlink installed files to the sources where possible")
+    add("--cmake-args", action="append", default=[], metavar="ARG",
+        help="arguments for CMake (values may start with '-')")
+    add("--ament-cmake-args", action="append", default=[], metavar="ARG", help="arguments for ament_cmake packages")
+
+
+def build_options(args: argparse.Namespace, root: Path, **extra):
+    from roc.handlers.context import BuildOptions
+
+    return BuildOptions(
+        build_base=(root / args.build_base).absolute(), install_base=(root / args.install_base).absolute(),
+        merge_install=args.merge_install, symlink_install=args.symlink_install,
+        cmake_args=tuple(args.cmake_args), ament_cmake_args=tuple(args.ament_cmake_args), **extra,
+    )
 
 
 def rewrite_passthrough(argv: list[str], known_options: set[str]) -> list[str]:
@@ -132,17 +147,14 @@ def _build(args, workspace, build_base: Path, install_base: Path, switches: dict
     from roc.engine.executor import execute
     from roc.engine.jobserver import Jobserver, jobs_from_makeflags
     from roc.engine.store import DurationStore
-    from roc.handlers.context import BuildOptions
     from roc.output.console import ConsoleHandler
     from roc.output.logs import JsonEventsHandler, LogHandler, ResultStore, new_log_directory
     from roc.shell.scripts import write_install_scripts
 
     workers = 1 if args.executor == "sequential" else args.parallel_workers
     jobs = args.jobs or jobs_from_makeflags(os.environ.get("MAKEFLAGS", "")) or os.cpu_count() or 1
-    options = BuildOptions(
-        build_base=build_base, install_base=install_base, merge_install=args.merge_install,
-        symlink_install=args.symlink_install, cmake_args=tuple(args.cmake_args),
-        ament_cmake_args=tuple(args.ament_cmake_args), cmake_target=args.cmake_target,
+    options = build_options(
+        args, workspace.root, cmake_target=args.cmake_target,
         cmake_target_skip_unavailable=args.cmake_target_skip_unavailable,
         cmake_clean_cache=args.cmake_clean_cache, cmake_clean_first=args.cmake_clean_first,
         cmake_force_configure=args.cmake_force_configure, jobs=jobs, force=args.force,

@@ -78,8 +78,6 @@ def check_spec(spec: PackageSpec) -> None:
     for kind, value in (("node", spec.node), ("library", spec.library)):
         if value is not None:
             check_name(kind, value)
-    if spec.python and spec.name == "test":
-        raise UsageError("an ament_python package cannot be named 'test' (its tests live in test/)")
     if spec.interfaces:
         if spec.build_type != "ament_cmake":
             raise UsageError("--interfaces makes an ament_cmake package; leave out --build-type "
@@ -89,6 +87,8 @@ def check_spec(spec: PackageSpec) -> None:
                              "put code in another package that depends on the interfaces")
         if spec.package_format < 3:
             raise UsageError("--interfaces needs --package-format 3 (for <member_of_group>)")
+    if spec.python and spec.name == "test":
+        raise UsageError("an ament_python package cannot be named 'test' (its tests live in test/)")
     pattern = _PYTHON_DEPENDENCY if spec.python else _CMAKE_DEPENDENCY
     for dependency in spec.dependencies:
         if not pattern.fullmatch(dependency):

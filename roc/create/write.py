@@ -26,7 +26,7 @@ def write_package(destination: Path, name: str, files: dict[str, str]) -> Path:
         for relative, text in files.items():
             path = staging / relative
             path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(text)
+            path.write_text(text, encoding="utf-8")
         if target.exists() or target.is_symlink():  # appeared meanwhile: keep it as it is
             raise RocError(f"{target} already exists; remove it or choose another name or --destination-directory")
         os.rename(staging, target)

@@ -97,8 +97,9 @@ class ConsoleHandler:
         else:
             self.aborted.append(name)
             line = f"Aborted  <<< {name} [{format_duration(event.duration)}]"
-        if self.start_end or not isinstance(event, TaskFinished):
-            self._print(line)
+        if isinstance(event, TaskFinished) and (event.cached or not self.start_end):
+            return  # up-to-date packages are counted in the summary
+        self._print(line)
 
     def _print_summary(self, event: RunFinished) -> None:
         total = format_duration(time.monotonic() - self.started_at)

@@ -1,0 +1,62 @@
+"""``roc work cache key|export|import``: build results for CI caches.
+
+``key`` prints a stable key of the workspace's sources, options and toolchain (a CI cache key);
+``export PATH`` stores the up-to-date packages; ``import PATH`` restores them in this workspace (which
+may be a clone in another directory), after which ``roc work build`` skips every unchanged package.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import sys
+
+from roc.commands.work_build import add_layout_arguments, build_options
+from roc.workspace.selection import add_selection_arguments
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("action", choices=("key", "export", "import"), help="what to do")
+    parser.add_argument("path", nargs="?", metavar="PATH", help="the cache directory (export, import)")
+    add_layout_arguments(parser)
+    add_selection_arguments(parser)
+
+
+def run(args: argparse.Namespace) -> int:
+    from roc.build.cache_store import check_isolated, export_cache, import_cache
+    from roc.build.plan import fingerprint_packages
+    from roc.errors import UsageError
+    from roc.workspace.load import load_workspace
+    from pathlib import Path
+
+    if args.action != "key" and not args.path:
+        raise UsageError(f"roc work cache {args.action} needs the cache directory: roc work cache {args.action} PATH")
+    workspace = load_workspace(args)
+    options = build_options(args, workspace.root)
+    if args.action == "key":
+        states = fingerprint_packages(workspace, options)
+        data = json.dumps({name: state.fingerprint for name, state in sorted(states.items())})
+        print(f"roc-{hashlib.sha256(data.encode()).hexdigest()[:40]}")
+        return 0
+    check_isolated(options.install_base, options.merge_install)
+    cache = Path(args.path).absolute()
+    if args.action == "export":
+        stored = export_cache(cache, workspace.root, options.build_base, options.install_base,
+                              workspace.selected_in_order())
+        print(f"exported {len(stored)} up-to-date package(s) to {cache}")
+        return 0
+    from roc.build.layout import installed_in_order, prepare_build_base, prepare_install_base
+    from roc.shell.scripts import write_install_scripts
+    import os
+
+    prepare_build_base(options.build_base)
+    prepare_install_base(options.install_base, merged=False)
+    restored, left_out = import_cache(cache, workspace.root, options.build_base, options.install_base,
+                                      {p.name: p for p in workspace.selected_in_order()})
+    underlays = [p for p in os.environ.get("COLCON_PREFIX_PATH", "").split(os.pathsep) if p]
+    write_install_scripts(options.install_base, installed_in_order(options.install_base, False), False, underlays)
+    print(f"imported {len(restored)} package(s) from {cache}")
+    for name, why in sorted(left_out.items()):
+        print(f"  left out {name} (it will be rebuilt): {why}", file=sys.stderr)
+    return 0
