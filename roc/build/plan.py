@@ -73,8 +73,9 @@ def _options_digest(package: Package, options: BuildOptions) -> dict:
         "type": package.type,
         "merge": options.merge_install,
         "symlink": options.symlink_install,
-        "cmake_args": list(options.cmake_args) if cmake_based else [],
-        "ament_cmake_args": list(options.ament_cmake_args) if package.build_type == "ament_cmake" else [],
+        "cmake_args": list(options.cmake_args_for(package.name)) if cmake_based else [],
+        "ament_cmake_args": list(options.ament_cmake_args_for(package.name)) if package.build_type == "ament_cmake"
+        else [],
     }
 
 

@@ -12,6 +12,8 @@ import importlib
 import os
 import sys
 
+from pathlib import Path
+
 from roc import __version__
 from roc.errors import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_USAGE, RocError
 
@@ -24,9 +26,14 @@ COMMANDS = (
     (("work", "build"), ("b",), "work_build", "build the workspace (a drop-in for colcon build)"),
     (("work", "env"), (), "work_env", "print a package's build environment, or run a command in it"),
     (("work", "cache"), (), "work_cache", "CI caching of build results: cache key | export PATH | import PATH"),
+    (("work", "config"), (), "work_config", "print the effective configuration and where each value comes from"),
     (("work", "create"), (), "work_create", "create a new package from a template (like ros2 pkg create)"),
     (("completion",), (), "completion", "print a shell completion script: bash, zsh or fish"),
 )
+
+
+# Verbs whose options roc.toml and colcon's defaults files can set.
+CONFIGURED_VERBS = ("list", "info", "graph", "build", "env", "cache")
 
 
 class Parser(argparse.ArgumentParser):
@@ -63,6 +70,7 @@ def build_parser(argv: list[str] | None = None) -> Parser:
     parser.add_argument("--version", action="version", version=f"roc {__version__}")
     parser.add_argument("--debug", action="store_true", help="show Python tracebacks for errors")
     parser.add_argument("-C", dest="directory", metavar="DIR", help="run as if roc was started in DIR")
+    leaves: dict[tuple[str, ...], Parser] = {}
     groups: dict[tuple[str, ...], argparse._SubParsersAction] = {
         (): parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     }
@@ -74,8 +82,34 @@ def build_parser(argv: list[str] | None = None) -> Parser:
         else:
             if wanted is None or wanted == path:
                 _command_module(module).add_arguments(sub)
+                if path[0] == "work" and path[-1] in CONFIGURED_VERBS:
+                    sub.add_argument("--profile", metavar="NAME", help="use [profile.NAME] of roc.toml")
             sub.set_defaults(_module=module, _group=None)
+            leaves[path] = sub
+    parser.leaves = leaves  # type: ignore[attr-defined]
     return parser
+
+
+def _early_value(argv: list[str], option: str) -> str | None:
+    """The value of ``option`` (``-C DIR``, ``--profile NAME``) before argparse runs."""
+    for index, word in enumerate(argv):
+        if word == option and index + 1 < len(argv):
+            return argv[index + 1]
+        if word.startswith(option + "="):
+            return word.split("=", 1)[1]
+    return None
+
+
+def _apply_workspace_configuration(parser: Parser, path: tuple[str, ...], argv: list[str]):
+    """Make roc.toml / colcon defaults the defaults of the command's options (the command line wins)."""
+    from roc.config import apply_configuration, load_configuration
+    from roc.workspace.root import find_workspace_root
+
+    cwd = Path.cwd()
+    root = find_workspace_root(cwd) or cwd
+    config = load_configuration(root, path[-1], _early_value(argv, "--profile"))
+    apply_configuration(parser.leaves[path], config)  # type: ignore[attr-defined]
+    return config
 
 
 def _command_module(name: str):
@@ -86,22 +120,28 @@ def main(argv: list[str] | None = None) -> int:
     debug = os.environ.get("ROC_DEBUG") == "1" or "--debug" in (argv if argv is not None else sys.argv[1:])
     try:
         argv = list(sys.argv[1:] if argv is None else argv)
+        directory = _early_value(argv[: argv.index("work")] if "work" in argv else argv, "-C")
+        if directory:
+            try:
+                os.chdir(directory)
+            except OSError as error:
+                raise RocError(f"-C {directory}: {error.strerror}") from None
         parser = build_parser(argv)
+        path = _requested_command(argv)
+        config = None
+        if path in parser.leaves and path[0] == "work" and path[-1] in CONFIGURED_VERBS:  # type: ignore[attr-defined]
+            config = _apply_workspace_configuration(parser, path, argv)
         if any(token in argv for token in ("--cmake-args", "--ament-cmake-args")):
             from roc.commands.completion import all_options
             from roc.commands.work_build import rewrite_passthrough
 
             argv = rewrite_passthrough(argv, all_options(parser))
         args = parser.parse_args(argv)
+        args.configuration = config
         module = getattr(args, "_module", None)
         if module is None:
             (getattr(args, "_group", None) or parser).print_help(sys.stderr)
             return EXIT_USAGE
-        if args.directory:
-            try:
-                os.chdir(args.directory)
-            except OSError as error:
-                raise RocError(f"-C {args.directory}: {error.strerror}") from None
         return _command_module(module).run(args)
     except RocError as error:
         if debug:

@@ -72,13 +72,26 @@ def add_layout_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def build_options(args: argparse.Namespace, root: Path, **extra):
+    """BuildOptions from the command line and the configuration's per-package settings."""
     from roc.handlers.context import BuildOptions
 
+    config = getattr(args, "configuration", None)
+    per_package = {key: {name: tuple(value) for name, value in config.package_values(key).items()}
+                   if config else {} for key in ("cmake-args", "ament-cmake-args")}
     return BuildOptions(
         build_base=(root / args.build_base).absolute(), install_base=(root / args.install_base).absolute(),
         merge_install=args.merge_install, symlink_install=args.symlink_install,
-        cmake_args=tuple(args.cmake_args), ament_cmake_args=tuple(args.ament_cmake_args), **extra,
+        cmake_args=tuple(args.cmake_args), ament_cmake_args=tuple(args.ament_cmake_args),
+        package_cmake_args=per_package["cmake-args"], package_ament_cmake_args=per_package["ament-cmake-args"],
+        **extra,
     )
+
+
+def skip_configured_packages(args: argparse.Namespace, workspace) -> None:
+    """Packages with ``skip = true`` in roc.toml are not built (they stay in the graph)."""
+    config = getattr(args, "configuration", None)
+    if config:
+        workspace.selected -= {name for name, skip in config.package_values("skip").items() if skip}
 
 
 def rewrite_passthrough(argv: list[str], known_options: set[str]) -> list[str]:
@@ -130,6 +143,7 @@ def run(args: argparse.Namespace) -> int:
     if args.parallel_workers < 0:
         raise UsageError("--parallel-workers must be 0 (no limit) or more")
     workspace = load_workspace(args)
+    skip_configured_packages(args, workspace)
     root = workspace.root
     build_base = (root / args.build_base).absolute()
     install_base = (root / args.install_base).absolute()

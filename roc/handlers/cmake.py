@@ -16,9 +16,9 @@ from roc.handlers.context import BuildOptions, PackageJob
 
 
 def cmake_arguments(job: PackageJob, options: BuildOptions) -> list[str]:
-    args = [*options.cmake_args]
+    args = [*options.cmake_args_for(job.package.name)]
     if job.package.build_type == "ament_cmake":
-        args += options.ament_cmake_args
+        args += options.ament_cmake_args_for(job.package.name)
         if options.symlink_install:
             args.append("-DAMENT_CMAKE_SYMLINK_INSTALL=1")
     return args

@@ -24,8 +24,17 @@ class BuildOptions:
     cmake_clean_first: bool = False
     cmake_force_configure: bool = False
     jobs: int = 2
+    # Per-package additions (roc.toml [package.NAME], colcon.meta), appended to the common arguments.
+    package_cmake_args: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    package_ament_cmake_args: dict[str, tuple[str, ...]] = field(default_factory=dict)
     force: bool = False  # rebuild even when up to date
     use_state: bool = True  # read and write fingerprints (--no-cache turns it off)
+
+    def cmake_args_for(self, package: str) -> tuple[str, ...]:
+        return self.cmake_args + self.package_cmake_args.get(package, ())
+
+    def ament_cmake_args_for(self, package: str) -> tuple[str, ...]:
+        return self.ament_cmake_args + self.package_ament_cmake_args.get(package, ())
 
     def partial(self) -> bool:
         """Builds that do not leave a complete, reusable install (never recorded as up to date)."""

@@ -44,9 +44,10 @@ def write_hook(prefix: Path, package: str, name: str, line: str) -> str:
 
 
 def write_package_scripts(prefix: Path, package: str, hooks: list[str]) -> None:
-    """``share/<package>/package.{dsv,sh,bash,zsh}``: the hooks, then the package's own local_setup."""
+    """``share/<package>/package.{dsv,sh,bash,zsh}``: the hooks (files below ``prefix``), then the
+    package's own local_setup."""
     share = prefix / "share" / package
-    lines = [f"source;{hook}.{ext}" for hook in hooks for ext in ("dsv", "sh")]
+    lines = [f"source;{hook}" for hook in hooks]
     lines += [f"source;share/{package}/local_setup.{ext}" for ext in ("bash", "dsv", "sh", "zsh")
               if (share / f"local_setup.{ext}").exists()]
     write_text_atomic(share / "package.dsv", "".join(f"{line}\n" for line in lines))

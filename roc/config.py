@@ -1,0 +1,228 @@
+"""Workspace configuration: ``roc.toml``, and colcon's ``defaults.yaml`` files for existing workspaces.
+
+Values become argparse defaults, so the command line always wins. Precedence, highest first:
+``[profile.NAME.VERB]`` and ``[profile.NAME]`` (with ``--profile NAME``), ``[VERB]``, ``[defaults]`` of
+``roc.toml``; ``colcon_defaults.yaml`` in the workspace root; ``$COLCON_DEFAULTS_FILE`` (else
+``~/.colcon/defaults.yaml``). ``[package.NAME]`` holds per-package settings (``cmake-args``,
+``ament-cmake-args``, ``skip``); colcon's ``colcon.meta`` ``names`` section is read for the same.
+
+    [defaults]              # every verb
+    base-paths = ["src"]
+    [build]                 # roc work build
+    parallel-workers = 4
+    cmake-args = ["-DCMAKE_BUILD_TYPE=RelWithDebInfo"]
+    [profile.release.build]
+    cmake-args = ["-DCMAKE_BUILD_TYPE=Release"]
+    [package.my_driver]
+    cmake-args = ["-DWITH_FOO=ON"]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+from pathlib import Path
+
+from roc.errors import UsageError
+
+VERBS = ("list", "info", "graph", "build", "env", "cache", "create")
+PACKAGE_KEYS = {"cmake-args": list, "ament-cmake-args": list, "skip": bool}
+ROC_TOML = "roc.toml"
+
+
+class ConfigError(UsageError):
+    def __init__(self, path: Path, key: str, message: str, line: int | None = None):
+        where = f"{path}:{line}" if line else str(path)
+        super().__init__(f"{where}: '{key}': {message}")
+
+
+def _line_of(text: str, table: str, key: str) -> int | None:
+    """The line of ``key`` inside ``[table]`` (tomllib does not say where a value came from)."""
+    in_table = table == ""
+    for number, line in enumerate(text.splitlines(), 1):
+        stripped = line.strip()
+        if stripped.startswith("["):
+            in_table = stripped.strip("[] ").replace('"', "") == table
+        elif in_table and re.match(rf'\s*"?{re.escape(key)}"?\s*=', line):
+            return number
+    return None
+
+
+class Setting:
+    """One configured value and where it came from."""
+
+    def __init__(self, value, source: str, path: Path, table: str, key: str, line: int | None):
+        self.value, self.source, self.path, self.table, self.key, self.line = value, source, path, table, key, line
+
+
+class Configuration:
+    def __init__(self) -> None:
+        self.layers: list[dict[str, Setting]] = []  # lowest precedence first
+        self.packages: dict[str, dict[str, Setting]] = {}
+
+    def add_layer(self, values: dict, source: str, path: Path, table: str, text: str | None) -> None:
+        layer = {}
+        for key, value in values.items():
+            line = _line_of(text, table, key) if text is not None else None
+            layer[key] = Setting(value, source, path, table, key, line)
+        self.layers.append(layer)
+
+    def package_values(self, key: str) -> dict[str, object]:
+        """``key`` of every package that sets it, e.g. {"my_driver": ["-DWITH_FOO=ON"]}."""
+        return {name: settings[key].value for name, settings in self.packages.items() if key in settings}
+
+    def effective(self) -> dict[str, Setting]:
+        merged: dict[str, Setting] = {}
+        for layer in self.layers:
+            merged.update(layer)
+        return merged
+
+
+def _dest(key: str) -> str:
+    return key.replace("-", "_")
+
+
+def _check_type(setting: Setting, action: argparse.Action):
+    """The value converted for ``action``, or a ConfigError that says what is expected."""
+    value = setting.value
+    expected: str
+    if isinstance(action, (argparse._StoreTrueAction, argparse._StoreFalseAction)):
+        if isinstance(value, bool):
+            return value
+        expected = "true or false"
+    elif action.nargs in ("*", "+") or isinstance(action, argparse._AppendAction):
+        if isinstance(value, list) and all(isinstance(v, (str, int, float)) for v in value):
+            converted = [str(v) for v in value]
+            if action.nargs == "+" and not converted:
+                expected = "a non-empty list"
+            else:
+                return converted
+        else:
+            expected = "a list of strings"
+    elif action.type is int:
+        if isinstance(value, int) and not isinstance(value, bool):
+            return value
+        expected = "a whole number"
+    elif isinstance(value, str):
+        if action.choices and value not in action.choices:
+            expected = f"one of {', '.join(map(str, action.choices))}"
+        else:
+            return value
+    else:
+        expected = "a string"
+    raise ConfigError(setting.path, setting.key, f"must be {expected}, not {value!r}", setting.line)
+
+
+def load_configuration(root: Path, verb: str, profile: str | None) -> Configuration:
+    config = Configuration()
+    _load_colcon_defaults(config, root, verb)
+    _load_colcon_meta(config, root / "colcon.meta")
+    toml_path = root / ROC_TOML
+    if toml_path.is_file():
+        _load_roc_toml(config, toml_path, verb, profile)
+    elif profile:
+        raise UsageError(f"--profile {profile}: there is no {toml_path}")
+    return config
+
+
+def _load_colcon_defaults(config: Configuration, root: Path, verb: str) -> None:
+    files = []
+    user = os.environ.get("COLCON_DEFAULTS_FILE") or os.path.join(
+        os.environ.get("COLCON_HOME", os.path.join(os.path.expanduser("~"), ".colcon")), "defaults.yaml")
+    files.append(Path(user))
+    files.append(root / "colcon_defaults.yaml")
+    for path in files:
+        if not path.is_file():
+            continue
+        import yaml
+
+        try:
+            data = yaml.safe_load(path.read_text()) or {}
+        except yaml.YAMLError as error:
+            line = getattr(getattr(error, "problem_mark", None), "line", None)
+            raise ConfigError(path, verb, f"invalid YAML: {getattr(error, 'problem', error)}",
+                              line + 1 if line is not None else None) from None
+        if not isinstance(data, dict):
+            raise ConfigError(path, "(top level)", "must map verb names to their options")
+        section = data.get(verb) or {}
+        if not isinstance(section, dict):
+            raise ConfigError(path, verb, "must map option names to values")
+        config.add_layer(section, f"{path.name} [{verb}]", path, verb, None)
+
+
+def _load_colcon_meta(config: Configuration, path: Path) -> None:
+    """colcon.meta's ``names`` section: per-package arguments (roc.toml's [package.NAME] wins)."""
+    if not path.is_file():
+        return
+    import yaml
+
+    from roc.messages import warn
+
+    try:
+        data = yaml.safe_load(path.read_text()) or {}
+    except yaml.YAMLError as error:
+        raise ConfigError(path, "(syntax)", f"invalid YAML: {getattr(error, 'problem', error)}") from None
+    for name, settings in (data.get("names") or {}).items() if isinstance(data, dict) else ():
+        for key, value in (settings or {}).items():
+            if key not in PACKAGE_KEYS:
+                warn(f"{path}: '{key}' of package '{name}' is not used by roc (it uses {', '.join(PACKAGE_KEYS)})")
+                continue
+            config.packages.setdefault(name, {})[key] = Setting(value, "colcon.meta", path, name, key, None)
+
+
+def _load_roc_toml(config: Configuration, path: Path, verb: str, profile: str | None) -> None:
+    import tomllib
+
+    text = path.read_text()
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        match = re.search(r"line (\d+)", str(error))
+        raise ConfigError(path, "(syntax)", f"invalid TOML: {error}", int(match.group(1)) if match else None) from None
+    known_tables = {"defaults", "profile", "package", *VERBS}
+    for table, values in data.items():
+        if table not in known_tables or not isinstance(values, dict):
+            raise ConfigError(path, table, f"unknown table; use [defaults], [{'], ['.join(VERBS)}], "
+                                           "[profile.NAME], [package.NAME]", _line_of(text, table, table) or
+                              next((n for n, line in enumerate(text.splitlines(), 1) if f"[{table}" in line), None))
+    config.add_layer(data.get("defaults", {}), f"{ROC_TOML} [defaults]", path, "defaults", text)
+    config.add_layer(data.get(verb, {}), f"{ROC_TOML} [{verb}]", path, verb, text)
+    if profile:
+        profiles = data.get("profile", {})
+        if profile not in profiles:
+            available = ", ".join(sorted(profiles)) or "none"
+            raise UsageError(f"--profile {profile}: {path} has no [profile.{profile}] (profiles: {available})")
+        chosen = profiles[profile]
+        shared = {k: v for k, v in chosen.items() if not isinstance(v, dict)}
+        config.add_layer(shared, f"{ROC_TOML} [profile.{profile}]", path, f"profile.{profile}", text)
+        config.add_layer(chosen.get(verb, {}), f"{ROC_TOML} [profile.{profile}.{verb}]", path,
+                         f"profile.{profile}.{verb}", text)
+    for name, settings in data.get("package", {}).items():
+        table = f"package.{name}"
+        package = config.packages.setdefault(name, {})
+        for key, value in settings.items():
+            setting = Setting(value, f"{ROC_TOML} [{table}]", path, table, key, _line_of(text, table, key))
+            expected = PACKAGE_KEYS.get(key)
+            if expected is None:
+                raise ConfigError(path, key, f"unknown package setting; use {', '.join(PACKAGE_KEYS)}", setting.line)
+            if not isinstance(value, expected) or (expected is list and not all(isinstance(v, str) for v in value)):
+                kind = "a list of strings" if expected is list else "true or false"
+                raise ConfigError(path, key, f"must be {kind}", setting.line)
+            package[key] = setting
+
+
+def apply_configuration(parser: argparse.ArgumentParser, config: Configuration) -> dict[str, Setting]:
+    """Validate every configured option against ``parser`` and make it a default; returns them."""
+    actions = {a.dest: a for a in parser._actions if a.option_strings}
+    applied: dict[str, Setting] = {}
+    for key, setting in config.effective().items():
+        action = actions.get(_dest(key))
+        if action is None or action.dest in ("help", "profile"):
+            options = sorted(o for a in actions.values() for o in a.option_strings
+                             if o.startswith("--") and o not in ("--help", "--profile"))
+            raise ConfigError(setting.path, key, f"not an option of this verb; options: {' '.join(options)}",
+                              setting.line)
+        applied[action.dest] = setting
+        parser.set_defaults(**{action.dest: _check_type(setting, action)})
+    return applied
