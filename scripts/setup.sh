@@ -66,6 +66,15 @@ fi
 start=$SECONDS
 export PIP_NO_INPUT=1 PIP_DISABLE_PIP_VERSION_CHECK=1
 
+# ---- shells the tests source roc's setup scripts in (optional: their tests skip without them) --
+if ! command -v zsh >/dev/null 2>&1 || ! command -v fish >/dev/null 2>&1; then
+    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+        say "installing zsh and fish (apt-get)"
+        { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq zsh fish; } >/dev/null 2>&1 \
+            || say "could not install zsh/fish; their tests will be skipped"
+    fi
+fi
+
 # ---- venv -------------------------------------------------------------------------------
 if [ ! -x "$VPY" ] || ! "$VPY" -c '' >/dev/null 2>&1; then
     command -v "$PYTHON" >/dev/null 2>&1 || die "'$PYTHON' not found (set PYTHON=/path/to/python3.11)"

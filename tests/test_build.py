@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import signal
 import subprocess
 import time
@@ -51,6 +52,21 @@ def test_build_then_source_and_run(tmp_path):
     assert (latest / "core" / "stdout_stderr.log").is_file() and (latest / "events.log").is_file()
     assert (ws / "build" / "app" / "colcon_build.rc").read_text().strip() == "0"
     assert json.loads((ws / "build" / "app" / "roc_build_environment.json").read_text())["AMENT_PREFIX_PATH"]
+
+
+@pytest.mark.skipif(shutil.which("zsh") is None, reason="zsh is not installed")
+def test_setup_zsh_and_setup_sh(tmp_path):
+    ws = copy_fixture("build_small", tmp_path / "ws")
+    assert roc("work", "build", "--packages-up-to", "app", "--packages-select", "app", "core", cwd=ws).returncode == 0
+    env = {"HOME": str(tmp_path), "PATH": "/usr/bin:/bin"}
+    for command in (["zsh", "-f", "-c", "setopt nounset; source install/setup.zsh; install/app/lib/app/app"],
+                    ["sh", "-c", "set -u; . install/setup.sh; install/app/lib/app/app"]):
+        ran = subprocess.run(command, cwd=ws, env=env, capture_output=True, text=True, timeout=60)
+        assert ran.returncode == 0 and "core says 42" in ran.stdout, (command, ran.stdout, ran.stderr)
+    # sh cannot know where a sourced script is: away from the workspace it uses the build-time path.
+    away = subprocess.run(["sh", "-c", f". '{ws}/install/setup.sh'; echo $CMAKE_PREFIX_PATH"], cwd=tmp_path,
+                          env=env, capture_output=True, text=True, timeout=60)
+    assert away.stdout.strip() == f"{ws}/install/app:{ws}/install/core"
 
 
 @pytest.mark.colcon
