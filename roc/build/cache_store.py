@@ -11,7 +11,6 @@ rebuilds it. Only the isolated install layout is supported.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import re
@@ -24,7 +23,7 @@ from roc import __version__
 from roc.build.finish import finish_package
 from roc.build.state import STATE_FILE, install_intact, read_state
 from roc.errors import RocError, UsageError
-from roc.fsutil import write_text_atomic
+from roc.fsutil import file_sha256, write_text_atomic
 from roc.messages import warn
 from roc.workspace.package import Package
 
@@ -37,14 +36,6 @@ REWRITABLE = ("install_manifest.txt", "install.log", "SOURCES.txt", "local_setup
 REWRITABLE_DIRS = ("parent_prefix_path",)
 # roc's own generated scripts: written again for the new place.
 REGENERATED = ("package.sh", "package.bash", "package.zsh")
-
-
-def _sha256(path: Path) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as handle:
-        for chunk in iter(lambda: handle.read(1 << 20), b""):
-            digest.update(chunk)
-    return digest.hexdigest()
 
 
 def export_cache(destination: Path, root: Path, build_base: Path, install_base: Path,
@@ -67,7 +58,7 @@ def export_cache(destination: Path, root: Path, build_base: Path, install_base: 
                     if (build_dir / name).exists():
                         tar.add(build_dir / name, arcname=f"build/{package.name}/{name}")
             os.replace(temporary, archive)
-        entries[package.name] = {"fingerprint": fingerprint, "sha256": _sha256(archive)}
+        entries[package.name] = {"fingerprint": fingerprint, "sha256": file_sha256(archive)}
     index = {"roc": __version__, "workspace": str(root), "install_base": str(install_base),
              "build_base": str(build_base), "packages": entries}
     write_text_atomic(destination / INDEX, json.dumps(index, indent=1, sort_keys=True))
@@ -115,7 +106,7 @@ def import_cache(source: Path, root: Path, build_base: Path, install_base: Path,
         if name not in packages:
             continue
         archive = source / "objects" / f"{entry['fingerprint']}.tar.gz"
-        if not archive.is_file() or _sha256(archive) != entry["sha256"]:
+        if not archive.is_file() or file_sha256(archive) != entry["sha256"]:
             left_out[name] = "its cache entry is missing or damaged"
             warn(f"{archive}: missing or damaged cache entry; '{name}' will be rebuilt")
             continue

@@ -15,6 +15,7 @@ import shutil
 import sys
 from pathlib import Path
 
+from roc.fsutil import file_sha256
 from roc.workspace.identify import IGNORE_MARKERS
 
 # Environment that shapes builds. Volatile variables (LD_LIBRARY_PATH, whose order changes from run
@@ -25,14 +26,6 @@ PREFIX_VARIABLES = ("AMENT_PREFIX_PATH", "CMAKE_PREFIX_PATH", "COLCON_PREFIX_PAT
 TOOLS = ("cmake", "make", "ninja", "cc", "c++", "gcc", "g++")
 
 FileStamps = dict[str, list]  # relative path -> [size, mtime_ns, sha256]
-
-
-def _sha256(path: Path) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as handle:
-        for chunk in iter(lambda: handle.read(1 << 20), b""):
-            digest.update(chunk)
-    return digest.hexdigest()
 
 
 def source_digest(directory: Path, previous: FileStamps) -> tuple[str, FileStamps]:
@@ -59,7 +52,7 @@ def source_digest(directory: Path, previous: FileStamps) -> tuple[str, FileStamp
                 if old and old[0] == info.st_size and old[1] == info.st_mtime_ns:
                     content = old[2]
                 else:
-                    content = _sha256(path)
+                    content = file_sha256(path)
             executable = bool(info.st_mode & 0o100)
             stamps[relative] = [info.st_size, info.st_mtime_ns, content, executable]
     digest = hashlib.sha256()

@@ -6,6 +6,10 @@ import argparse
 import os
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from roc.create.spec import PackageSpec
 
 BUILD_TYPES = ("ament_cmake", "ament_python", "cmake")
 
@@ -62,12 +66,13 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _spec(args: argparse.Namespace):
+def _spec(args: argparse.Namespace) -> tuple[PackageSpec, list[str]]:
+    """The checked package spec, and the notes to print once it is written."""
     from roc.create import licenses
     from roc.create.maintainer import default_maintainer
     from roc.create.spec import PackageSpec, check_spec
 
-    notes = []
+    notes: list[str] = []
     node = args.node_name
     if node is not None and node == args.library_name:
         node = f"{node}_node"

@@ -21,7 +21,7 @@ def _templates():
         loader=jinja2.PackageLoader("roc.create", "templates"), keep_trailing_newline=True,
         undefined=jinja2.StrictUndefined, autoescape=False, trim_blocks=True, lstrip_blocks=True,
     )
-    environment.filters["xml"] = lambda value: escape(str(value), {'"': "&quot;", "'": "&apos;"})
+    environment.filters["xml"] = lambda value: str(value)
     environment.filters["py"] = lambda value: repr(str(value))
     environment.filters["ref"] = lambda name: "${" + name + "}"  # a CMake variable reference
     environment.filters["camel"] = lambda value: "".join(part.capitalize() for part in value.split("_"))
@@ -33,7 +33,8 @@ def _plan(spec: PackageSpec) -> list[tuple[str, str]]:
     name, node, library = spec.name, spec.node, spec.library
     files = [("package.xml", "package.xml.j2")]
     if spec.interfaces:
-        files += [("CMakeLists.txt", "interfaces/CMakeLists.txt.j2"), ("msg/Greeting.msg", "interfaces/Greeting.msg.j2"),
+        files += [("CMakeLists.txt", "interfaces/CMakeLists.txt.j2"),
+                  ("msg/Greeting.msg", "interfaces/Greeting.msg.j2"),
                   ("srv/SetGreeting.srv", "interfaces/SetGreeting.srv.j2"),
                   ("action/Countdown.action", "interfaces/Countdown.action.j2")]
         if spec.tests:

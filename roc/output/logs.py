@@ -17,6 +17,14 @@ from roc.fsutil import write_text_atomic
 from roc.workspace.selection import INTERRUPTED_RESULT
 
 
+def event_json(event: Event) -> str:
+    """One event as a JSON object: its kind, task, time and fields (output decoded as text)."""
+    record = {"event": type(event).__name__, **asdict(event)}
+    if isinstance(event, TaskOutput):
+        record["data"] = event.data.decode(errors="replace")
+    return json.dumps(record)
+
+
 def new_log_directory(log_base: Path, verb: str = "build") -> Path:
     stamp = time.strftime("%Y-%m-%d_%H-%M-%S")
     directory = log_base / f"{verb}_{stamp}"
@@ -52,9 +60,7 @@ class LogHandler:
     def __call__(self, event: Event) -> None:
         if isinstance(event, Tick):
             return
-        record = {"event": type(event).__name__, **asdict(event)}
         if isinstance(event, TaskOutput):
-            record["data"] = event.data.decode(errors="replace")
             self._file(event.task, f"{event.stream}.log").write(event.data)
             self._file(event.task, "stdout_stderr.log").write(event.data)
             self._file(event.task, "streams.log").write(event.data)
@@ -66,7 +72,7 @@ class LogHandler:
             text = f"Invoked command '{shlex.join(event.command)}' returned '{event.returncode}'\n".encode()
             self._file(event.task, "command.log").write(text)
             self._file(event.task, "streams.log").write(text)
-        self._events.write(json.dumps(record) + "\n")
+        self._events.write(event_json(event) + "\n")
         if isinstance(event, RunFinished):
             self.close()
 
@@ -99,8 +105,5 @@ class JsonEventsHandler:
     def __call__(self, event: Event) -> None:
         if isinstance(event, Tick):
             return
-        record = {"event": type(event).__name__, **asdict(event)}
-        if isinstance(event, TaskOutput):
-            record["data"] = event.data.decode(errors="replace")
-        self.stream.write(json.dumps(record) + "\n")
+        self.stream.write(event_json(event) + "\n")
         self.stream.flush()
