@@ -21,7 +21,7 @@ def _templates():
         loader=jinja2.PackageLoader("roc.create", "templates"), keep_trailing_newline=True,
         undefined=jinja2.StrictUndefined, autoescape=False, trim_blocks=True, lstrip_blocks=True,
     )
-    environment.filters["xml"] = lambda value: str(value)
+    environment.filters["xml"] = lambda value: escape(str(value), {'"': "&quot;", "'": "&apos;"})
     environment.filters["py"] = lambda value: repr(str(value))
     environment.filters["ref"] = lambda name: "${" + name + "}"  # a CMake variable reference
     environment.filters["camel"] = lambda value: "".join(part.capitalize() for part in value.split("_"))
