@@ -60,3 +60,20 @@ def sourced_values(workspace: Path, setup: str = "install/setup.bash", strict: b
 
 def installed_files(install: Path) -> set[str]:
     return {str(p.relative_to(install)) for p in install.rglob("*") if not p.is_dir()}
+
+
+def ros_domain_id(base: int) -> str:
+    """A ROS domain of its own for each pytest-xdist worker, so tests never see each other's nodes."""
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
+    return str(base + int(worker.removeprefix("gw") or 0))
+
+
+def stop_process(process: subprocess.Popen) -> None:
+    """Stop a process the test started (by its PID): terminate, then kill if it does not exit."""
+    if process.poll() is None:
+        process.terminate()
+        try:
+            process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()

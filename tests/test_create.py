@@ -15,7 +15,9 @@ from xml.etree import ElementTree
 import pytest
 from catkin_pkg.package import parse_package
 
-from build_helpers import BIN, colcon, in_sourced_shell, installed_files, roc, ros_env, sourced_values
+from build_helpers import (
+    BIN, colcon, in_sourced_shell, installed_files, roc, ros_domain_id, ros_env, sourced_values, stop_process,
+)
 
 MAINTAINER = ("--maintainer-name", "Ada Lovelace", "--maintainer-email", "ada@example.com")
 OPTIONS = ("--build-type", "--dependencies", "--node-name", "--library-name", "--license", "--maintainer-name",
@@ -60,7 +62,7 @@ def build(ws: Path) -> None:
 
 
 def sourced(ws: Path, script: str, strict: bool = True) -> str:
-    ran = in_sourced_shell(ws, f"export ROS_DOMAIN_ID={_domain_id()}; {script}", strict=strict)
+    ran = in_sourced_shell(ws, f"export ROS_DOMAIN_ID={ros_domain_id(70)}; {script}", strict=strict)
     assert ran.returncode == 0, ran.stdout + ran.stderr
     return ran.stdout
 
@@ -70,22 +72,6 @@ def ctest(ws: Path, package: str) -> str:
     output = sourced(ws, f"ctest --test-dir build/{package} --output-on-failure")
     assert re.search(r"100% tests passed, 0 tests failed out of [1-9]", output), output
     return output
-
-
-def _domain_id() -> str:
-    """A ROS domain of its own for each pytest-xdist worker."""
-    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
-    return str(70 + int(worker.removeprefix("gw") or 0))
-
-
-def _stop(process: subprocess.Popen) -> None:
-    if process.poll() is None:
-        process.terminate()
-        try:
-            process.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait()
 
 
 # ---- generated packages, built and used --------------------------------------------------------
@@ -169,7 +155,7 @@ def test_python_node_publishes_on_the_ros_graph(tmp_path):
                         "-p period:=0.05 2>&1")
     assert re.findall(r"Publishing '(.*)'", alone) == ["Hello, talker! 1", "Hello, talker! 2", "Hello, talker! 3"]
     # A listener in another process receives its messages.
-    env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin", "ROS_DOMAIN_ID": _domain_id(),
+    env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin", "ROS_DOMAIN_ID": ros_domain_id(70),
            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST", "RMW_IMPLEMENTATION": "rmw_fastrtps_cpp"}
     listener_code = (
         "import time, rclpy\nfrom rclpy.node import Node\nfrom std_msgs.msg import String\n"
@@ -188,8 +174,8 @@ def test_python_node_publishes_on_the_ros_graph(tmp_path):
     try:
         output, _ = listener.communicate(timeout=60)
     finally:
-        _stop(listener)
-        _stop(talker)
+        stop_process(listener)
+        stop_process(talker)
     assert listener.returncode == 0, output
     assert len(re.findall(r"^Hello, talker! \d+$", output, re.MULTILINE)) >= 3, output
 

@@ -8,15 +8,11 @@ import subprocess
 
 import pytest
 
-from build_helpers import BIN, REPO, colcon, in_sourced_shell, installed_files, roc, sourced_values
+from build_helpers import (
+    BIN, REPO, colcon, in_sourced_shell, installed_files, roc, ros_domain_id, sourced_values, stop_process,
+)
 
 pytestmark = pytest.mark.slow
-
-
-def _domain_id() -> str:
-    """A ROS domain of its own for each pytest-xdist worker, so tests never see each other's nodes."""
-    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
-    return str(60 + int(worker.removeprefix("gw") or 0))
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +34,7 @@ def test_cpp_executables_and_interfaces(example):
 
 
 def test_python_node_messages_arrive(example):
-    env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin", "ROS_DOMAIN_ID": _domain_id(),
+    env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin", "ROS_DOMAIN_ID": ros_domain_id(60),
            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST", "RMW_IMPLEMENTATION": "rmw_fastrtps_cpp"}
     source = "set -eu; source install/setup.bash; exec "
     listener = subprocess.Popen(["bash", "-c", source + "install/demo_py/lib/demo_py/reading_listener "
@@ -52,12 +48,7 @@ def test_python_node_messages_arrive(example):
         output, _ = listener.communicate(timeout=60)
     finally:
         for process in (listener, publisher):
-            if process.poll() is None:
-                process.terminate()
-                try:
-                    process.wait(timeout=10)
-                except subprocess.TimeoutExpired:
-                    process.kill()
+            stop_process(process)
     assert listener.returncode == 0, output
     received = [line for line in output.splitlines() if "Received reading" in line]
     assert len(received) == 3 and all("celsius" in line for line in received), output

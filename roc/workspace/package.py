@@ -9,6 +9,8 @@ from __future__ import annotations
 from pathlib import Path
 
 CATEGORIES = ("build", "run", "test")
+# ``Manifest`` (roc.workspace.manifest) appears in annotations only; it is imported where a manifest is
+# decoded, not here, so that listing a workspace from the cache never loads it.
 
 
 class Package:
@@ -26,7 +28,7 @@ class Package:
         self, name: str, path: Path, type: str, dependencies: dict[str, set[str]] | None = None,  # noqa: A002
         hooks: list[str] | None = None, metadata: dict[str, object] | None = None,
         constraints: dict[str, dict[str, str]] | None = None, group_depends: list[str] | None = None,
-        member_of_groups: list[str] | None = None, manifest: Manifest | None = None,
+        member_of_groups: list[str] | None = None, manifest: Manifest | None = None,  # noqa: F821
     ):
         self.name = name
         self.path = path
@@ -41,7 +43,7 @@ class Package:
         self._manifest_data: dict | None = None  # from the cache, decoded on first use
 
     @property
-    def manifest(self) -> Manifest | None:
+    def manifest(self) -> Manifest | None:  # noqa: F821
         if self._manifest is None and self._manifest_data is not None:
             from roc.workspace.manifest import Manifest
 
@@ -50,7 +52,7 @@ class Package:
         return self._manifest
 
     @manifest.setter
-    def manifest(self, value: Manifest | None) -> None:
+    def manifest(self, value: Manifest | None) -> None:  # noqa: F821
         self._manifest, self._manifest_data = value, None
 
     def __repr__(self) -> str:
