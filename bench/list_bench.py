@@ -61,7 +61,9 @@ def environments(venv: Path) -> dict[str, dict[str, str]]:
     boot = dict(base)
     boot[BOOT_FLAG] = "1"
     boot["LD_LIBRARY_PATH"] = os.pathsep.join([wheel_library_path(venv)] + kept)
-    return {"plain": base, "boot": boot}
+    # "cold": as "boot", but roc's discovery cache can never be used (every run parses every manifest).
+    cold = dict(boot, ROC_CACHE_DIR="/proc/roc-discovery-cache-disabled")
+    return {"plain": base, "boot": boot, "cold": cold}
 
 
 def _children_cpu() -> float:
@@ -132,7 +134,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--roc-runs", type=int, default=10, help="timed runs of roc per measurement (10)")
     parser.add_argument("--colcon-runs", type=int, default=5, help="timed runs of colcon per measurement (5)")
     parser.add_argument("--warmup", type=int, default=2, help="untimed runs of each tool first (2)")
-    parser.add_argument("--variants", nargs="+", choices=["plain", "boot"], default=["plain", "boot"])
+    parser.add_argument("--variants", nargs="+", choices=["plain", "boot", "cold"], default=["plain", "boot", "cold"],
+                        help="plain: every start pays the wheels' bootstrap re-exec; boot: it is done already "
+                             "(a sourced environment); cold: boot without roc's discovery cache")
     parser.add_argument("--seed", type=int, default=0, help="generator seed (0)")
     parser.add_argument("--venv", type=Path, default=HERE.parent / ".venv", help="venv with roc and colcon")
     parser.add_argument("--work", type=Path, default=HERE / ".work", help="where workspaces are generated")

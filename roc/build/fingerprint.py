@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 from roc.fsutil import file_sha256
-from roc.workspace.identify import IGNORE_MARKERS
+from roc.workspace.package import IGNORE_MARKERS
 
 # Environment that shapes builds. Volatile variables (LD_LIBRARY_PATH, whose order changes from run
 # to run with the ROS wheels, PATH beyond the tools themselves, ...) are left out on purpose.

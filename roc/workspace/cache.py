@@ -16,7 +16,7 @@ from collections.abc import Callable, Mapping
 
 from roc import __version__, messages
 from roc.fsutil import write_text_atomic
-from roc.workspace.package import Package
+from roc.workspace.package import IGNORE_MARKERS, Package
 
 IDENTIFICATION_FILES = ("package.xml", "setup.py", "setup.cfg", "colcon.pkg", "CMakeLists.txt", "manifest.xml")
 
@@ -46,8 +46,10 @@ def _stamp(path: str) -> list[int] | None:
 
 
 def _inputs(root: Path, visited: list[str], packages: list[Package]) -> dict[str, list[int] | None]:
-    """Every directory and file whose change could change what discovery finds."""
-    inputs = {directory: _stamp(directory) for directory in visited}
+    """Every directory and file whose change could change what discovery finds. An ignore marker
+    counts by its presence alone (colcon rewrites log/COLCON_IGNORE on every run)."""
+    inputs = {path: [1] if os.path.basename(path) in IGNORE_MARKERS and os.path.exists(path) else _stamp(path)
+              for path in visited}
     for package in packages:
         directory = str(root / package.path)
         inputs[directory] = _stamp(directory)
@@ -65,6 +67,12 @@ def _inputs(root: Path, visited: list[str], packages: list[Package]) -> dict[str
     return inputs
 
 
+def _unchanged(path: str, stamp: list[int] | None) -> bool:
+    if stamp == [1]:  # an ignore marker: it must still be there
+        return os.path.exists(path)
+    return _stamp(path) == stamp
+
+
 def _condition_variables(packages: list[Package]) -> list[str]:
     return sorted({n for p in packages if p.manifest for n in p.manifest.condition_variables})
 
@@ -78,7 +86,7 @@ def cached_discovery(
     path = _cache_path(key)
     try:
         data = json.loads(path.read_text())
-        if data["key"] == key and all(_stamp(p) == stamp for p, stamp in data["inputs"].items()):
+        if data["key"] == key and all(_unchanged(p, stamp) for p, stamp in data["inputs"].items()):
             if all(variables.get(name) == value for name, value in data["conditions"].items()):
                 packages = [Package.from_dict(item) for item in data["packages"]]
                 for warning in data["warnings"]:

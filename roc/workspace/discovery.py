@@ -14,7 +14,7 @@ from collections.abc import Iterable, Mapping
 
 from roc.errors import UsageError, RocError
 from roc.workspace.identify import SkipLocation, identify
-from roc.workspace.package import Package
+from roc.workspace.package import IGNORE_MARKERS, Package
 
 
 def _expand(patterns: Iterable[str], root: Path) -> list[str]:
@@ -84,6 +84,9 @@ def _crawl(start: Path, shown_base: Path, variables, found: dict[str, Package], 
         try:
             package = identify(Path(dirpath), shown, set(filenames), variables)
         except SkipLocation:
+            markers = [os.path.join(dirpath, m) for m in IGNORE_MARKERS if m in filenames]
+            if markers:  # only the marker matters, not what changes below it (e.g. log/ during builds)
+                visited[-1:] = markers
             dirnames.clear()
             continue
         if package:

@@ -9,6 +9,8 @@ from __future__ import annotations
 from pathlib import Path
 
 CATEGORIES = ("build", "run", "test")
+# Files whose presence makes discovery skip a directory and everything below it.
+IGNORE_MARKERS = ("COLCON_IGNORE", "AMENT_IGNORE", "CATKIN_IGNORE")
 # ``Manifest`` (roc.workspace.manifest) appears in annotations only; it is imported where a manifest is
 # decoded, not here, so that listing a workspace from the cache never loads it.
 
