@@ -4,7 +4,8 @@ Values become argparse defaults, so the command line always wins. Precedence, hi
 ``[profile.NAME.VERB]`` and ``[profile.NAME]`` (with ``--profile NAME``), ``[VERB]``, ``[defaults]`` of
 ``roc.toml``; ``colcon_defaults.yaml`` in the workspace root; ``$COLCON_DEFAULTS_FILE`` (else
 ``~/.colcon/defaults.yaml``). ``[package.NAME]`` holds per-package settings (``cmake-args``,
-``ament-cmake-args``, ``skip``); colcon's ``colcon.meta`` ``names`` section is read for the same.
+``ament-cmake-args``, ``skip``); the ``names`` sections of colcon's metadata files (``colcon.meta``,
+``--metas``, ``~/.colcon/metadata/*.meta``) are read for the same.
 
     [defaults]              # every verb
     base-paths = ["src"]
@@ -114,10 +115,26 @@ def _check_type(setting: Setting, action: argparse.Action):
     raise ConfigError(setting.path, setting.key, f"must be {expected}, not {value!r}", setting.line)
 
 
-def load_configuration(root: Path, verb: str, profile: str | None) -> Configuration:
+def colcon_home() -> Path:
+    return Path(os.environ.get("COLCON_HOME") or os.path.join(os.path.expanduser("~"), ".colcon"))
+
+
+def meta_files(root: Path, metas: list[str] | None, ignore_user_meta: bool) -> list[Path]:
+    """colcon's metadata files, lowest precedence first: ``~/.colcon/metadata/*.meta`` (unless
+    ignored), then ``--metas`` (files, or directories holding a colcon.meta; default ./colcon.meta)."""
+    files = [] if ignore_user_meta else sorted((colcon_home() / "metadata").glob("*.meta"))
+    for given in metas if metas is not None else ["colcon.meta"]:
+        path = root / given
+        files.append(path / "colcon.meta" if path.is_dir() else path)
+    return files
+
+
+def load_configuration(root: Path, verb: str, profile: str | None, metas: list[str] | None = None,
+                       ignore_user_meta: bool = False) -> Configuration:
     config = Configuration()
     _load_colcon_defaults(config, root, verb)
-    _load_colcon_meta(config, root / "colcon.meta")
+    for path in meta_files(root, metas, ignore_user_meta):
+        _load_colcon_meta(config, path)
     toml_path = root / ROC_TOML
     if toml_path.is_file():
         _load_roc_toml(config, toml_path, verb, profile)
@@ -128,8 +145,7 @@ def load_configuration(root: Path, verb: str, profile: str | None) -> Configurat
 
 def _load_colcon_defaults(config: Configuration, root: Path, verb: str) -> None:
     files = []
-    user = os.environ.get("COLCON_DEFAULTS_FILE") or os.path.join(
-        os.environ.get("COLCON_HOME", os.path.join(os.path.expanduser("~"), ".colcon")), "defaults.yaml")
+    user = os.environ.get("COLCON_DEFAULTS_FILE") or str(colcon_home() / "defaults.yaml")
     files.append(Path(user))
     files.append(root / "colcon_defaults.yaml")
     for path in files:

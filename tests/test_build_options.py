@@ -80,7 +80,7 @@ def test_quiet_handlers_and_no_logs(ws):
     assert not (ws / "log").exists()
 
 
-@pytest.mark.parametrize("option", [["--test-result-base", "x"], ["--metas", "a"], ["--catkin-skip-building-tests"],
+@pytest.mark.parametrize("option", [["--test-result-base", "x"], ["--catkin-cmake-args", "-DX=1"], ["--catkin-skip-building-tests"],
                                     ["--event-handlers", "compile_commands+"], ["--event-handlers", "nonsense+"]])
 def test_unsupported_options_are_rejected(ws, option):
     result = roc("work", "build", *option, cwd=ws)

@@ -60,6 +60,20 @@ def test_package_settings_and_colcon_meta(ws):
     assert "beta" not in result.stdout
 
 
+def test_metas_and_user_metas(ws, tmp_path):
+    home = tmp_path / "colcon-home"
+    (home / "metadata").mkdir(parents=True)
+    (home / "metadata" / "mine.meta").write_text('{"names": {"alpha": {"cmake-args": ["-DFROM_USER=1"]}}}')
+    (ws / "extra.meta").write_text('{"names": {"beta": {"cmake-args": ["-DFROM_METAS=1"]}}}')
+    env = {**__import__("build_helpers").ros_env(), "COLCON_HOME": str(home)}
+    assert roc("work", "build", "--metas", "extra.meta", cwd=ws, env=env).returncode == 0
+    logs = ws / "log" / "latest_build"
+    assert "-DFROM_USER=1" in (logs / "alpha" / "command.log").read_text()
+    assert "-DFROM_METAS=1" in (logs / "beta" / "command.log").read_text()
+    assert roc("work", "build", "--ignore-user-meta", "--force", cwd=ws, env=env).returncode == 0
+    assert "-DFROM_USER=1" not in (logs / "alpha" / "command.log").read_text()
+
+
 def test_colcon_defaults_files(ws, tmp_path):
     user_defaults = tmp_path / "user-defaults.yaml"
     user_defaults.write_text("build:\n  parallel-workers: 3\n  symlink-install: true\n")

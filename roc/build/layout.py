@@ -61,3 +61,14 @@ def installed_in_order(install_base: Path, merged: bool) -> list[str]:
         text = marker.read_text().strip()
         run_dependencies[marker.name] = set(text.split(":")) if text else set()
     return layered_order(run_dependencies, one_at_a_time=True)
+
+
+def refresh_install_scripts(install_base: Path, merged: bool) -> None:
+    """The install-level setup scripts for every package now in the base, chained to the underlays
+    of the current environment (COLCON_PREFIX_PATH)."""
+    import os
+
+    from roc.shell.scripts import write_install_scripts
+
+    underlays = [p for p in os.environ.get("COLCON_PREFIX_PATH", "").split(os.pathsep) if p]
+    write_install_scripts(install_base, installed_in_order(install_base, merged), merged, underlays)

@@ -100,6 +100,18 @@ def _early_value(argv: list[str], option: str) -> str | None:
     return None
 
 
+def _early_values(argv: list[str], option: str) -> list[str] | None:
+    """The values after ``option`` up to the next option (``--metas A B``), None when it is absent."""
+    if option not in argv:
+        return None
+    values = []
+    for word in argv[argv.index(option) + 1:]:
+        if word.startswith("-"):
+            break
+        values.append(word)
+    return values
+
+
 def _apply_workspace_configuration(parser: Parser, path: tuple[str, ...], argv: list[str]):
     """Make roc.toml / colcon defaults the defaults of the command's options (the command line wins)."""
     from roc.config import apply_configuration, load_configuration
@@ -107,7 +119,9 @@ def _apply_workspace_configuration(parser: Parser, path: tuple[str, ...], argv: 
 
     cwd = Path.cwd()
     root = find_workspace_root(cwd) or cwd
-    config = load_configuration(root, path[-1], _early_value(argv, "--profile"))
+    metas = _early_values(argv, "--metas")
+    config = load_configuration(root, path[-1], _early_value(argv, "--profile"), metas,
+                                ignore_user_meta="--ignore-user-meta" in argv)
     apply_configuration(parser.leaves[path], config)  # type: ignore[attr-defined]
     return config
 

@@ -15,7 +15,7 @@ EVENT_HANDLERS = {"console_start_end", "console_stderr", "console_direct", "cons
                   "status", "log", "event_log", "store_result", "log_command"}
 NOT_SUPPORTED_HANDLERS = {"compile_commands", "desktop_notification", "terminal_title", "console_package_list",
                           "parallel_status"}
-NOT_SUPPORTED_OPTIONS = ("test_result_base", "metas", "ignore_user_meta", "catkin_cmake_args",
+NOT_SUPPORTED_OPTIONS = ("test_result_base", "catkin_cmake_args",
                          "catkin_skip_building_tests")
 # Options whose values are passed through to a tool and may themselves start with a dash.
 PASSTHROUGH_OPTIONS = ("--cmake-args", "--ament-cmake-args")
@@ -51,8 +51,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     cmake.add_argument("--cmake-force-configure", action="store_true", help="always run the CMake configure step")
     unsupported = parser.add_argument_group("colcon options roc does not support yet (rejected if used)")
     unsupported.add_argument("--test-result-base", help=argparse.SUPPRESS)
-    unsupported.add_argument("--metas", nargs="*", help=argparse.SUPPRESS)
-    unsupported.add_argument("--ignore-user-meta", action="store_true", default=None, help=argparse.SUPPRESS)
     unsupported.add_argument("--catkin-cmake-args", nargs="*", help=argparse.SUPPRESS)
     unsupported.add_argument("--catkin-skip-building-tests", action="store_true", default=None,
                              help=argparse.SUPPRESS)
@@ -62,6 +60,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def add_layout_arguments(parser: argparse.ArgumentParser) -> None:
     """The options that decide where packages go and what their fingerprints are (build and cache)."""
     add = parser.add_argument
+    add("--metas", nargs="*", metavar="PATH",
+        help="colcon metadata files, or directories holding a colcon.meta (default: ./colcon.meta)")
+    add("--ignore-user-meta", action="store_true", help="ignore the *.meta files in ~/.colcon/metadata")
     add("--build-base", default="build", help="base directory of the build directories (default: build)")
     add("--install-base", default="install", help="base directory of the install prefixes (default: install)")
     add("--merge-install", action="store_true", help="install all packages into one prefix")
@@ -104,7 +105,7 @@ def rewrite_passthrough(argv: list[str], known_options: set[str]) -> list[str]:
             current = token
             continue
         if current and token.split("=", 1)[0] not in known_options:
-            result.append(f"{current}={token.lstrip(' ') if token.startswith(' ') else token}")
+            result.append(f"{current}={token.lstrip(' ')}")
             continue
         current = None
         result.append(token)
@@ -142,30 +143,11 @@ def run(args: argparse.Namespace) -> int:
         args.packages_up_to = [*(args.packages_up_to or []), *args.packages]
     if args.parallel_workers < 0:
         raise UsageError("--parallel-workers must be 0 (no limit) or more")
+    from roc.build.lock import build_lock
+    from roc.engine.jobserver import jobs_from_makeflags
+
     workspace = load_workspace(args)
     skip_configured_packages(args, workspace)
-    root = workspace.root
-    build_base = (root / args.build_base).absolute()
-    install_base = (root / args.install_base).absolute()
-    from roc.build.lock import build_lock
-
-    with build_lock(build_base):
-        prepare_build_base(build_base)
-        prepare_install_base(install_base, args.merge_install)
-        return _build(args, workspace, build_base, install_base, switches)
-
-
-def _build(args, workspace, build_base: Path, install_base: Path, switches: dict[str, bool]) -> int:
-    from roc.build.layout import installed_in_order
-    from roc.build.plan import plan_build
-    from roc.engine.executor import execute
-    from roc.engine.jobserver import Jobserver, jobs_from_makeflags
-    from roc.engine.store import DurationStore
-    from roc.output.console import ConsoleHandler
-    from roc.output.logs import JsonEventsHandler, LogHandler, ResultStore, new_log_directory
-    from roc.shell.scripts import write_install_scripts
-
-    workers = 1 if args.executor == "sequential" else args.parallel_workers
     jobs = args.jobs or jobs_from_makeflags(os.environ.get("MAKEFLAGS", "")) or os.cpu_count() or 1
     options = build_options(
         args, workspace.root, cmake_target=args.cmake_target,
@@ -174,12 +156,21 @@ def _build(args, workspace, build_base: Path, install_base: Path, switches: dict
         cmake_force_configure=args.cmake_force_configure, jobs=jobs, force=args.force,
         use_state=not args.no_cache,
     )
-    durations = DurationStore(build_base / DURATIONS_FILE)
-    jobserver = Jobserver(jobs)
-    handlers = []
+    with build_lock(options.build_base):
+        prepare_build_base(options.build_base)
+        prepare_install_base(options.install_base, args.merge_install)
+        return _build(args, workspace, options, switches)
+
+
+def _output_handlers(args, switches: dict[str, bool], root: Path, build_base: Path) -> list:
+    """Where events go: logs, stored results, and the console (or JSON events)."""
+    from roc.output.console import ConsoleHandler
+    from roc.output.logs import JsonEventsHandler, LogHandler, ResultStore, new_log_directory
+
+    handlers: list = []
     log_dir = None
     if args.log_base != os.devnull and switches.get("log", True):
-        log_dir = new_log_directory((workspace.root / args.log_base).absolute())
+        log_dir = new_log_directory((root / args.log_base).absolute())
         handlers.append(LogHandler(log_dir))
     if switches.get("store_result", True):
         handlers.append(ResultStore(build_base))
@@ -197,16 +188,27 @@ def _build(args, workspace, build_base: Path, install_base: Path, switches: dict
             cohesion=switches.get("console_cohesion", False), log_path=str(log_dir) if log_dir else None,
             status=status,
         ))
-    handlers.append(durations)
+    return handlers
+
+
+def _build(args, workspace, options, switches: dict[str, bool]) -> int:
+    from roc.build.layout import refresh_install_scripts
+    from roc.build.plan import plan_build
+    from roc.engine.executor import execute
+    from roc.engine.jobserver import Jobserver
+    from roc.engine.store import DurationStore
+
+    workers = 1 if args.executor == "sequential" else args.parallel_workers
+    durations = DurationStore(options.build_base / DURATIONS_FILE)
+    jobserver = Jobserver(options.jobs)
+    handlers = [*_output_handlers(args, switches, workspace.root, options.build_base), durations]
     try:
         tasks = plan_build(workspace, options, jobserver, durations.durations)
         result = execute(tasks, handlers, workers, continue_on_error=args.continue_on_error)
     finally:
         jobserver.close()
     durations.save()
-    underlays = [p for p in os.environ.get("COLCON_PREFIX_PATH", "").split(os.pathsep) if p]
-    write_install_scripts(install_base, installed_in_order(install_base, args.merge_install), args.merge_install,
-                          underlays)
+    refresh_install_scripts(options.install_base, args.merge_install)
     if result.interrupted:
         return EXIT_INTERRUPTED
     return 0 if result.ok else EXIT_FAILURE

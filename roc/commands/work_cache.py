@@ -11,6 +11,7 @@ import argparse
 import hashlib
 import json
 import sys
+from pathlib import Path
 
 from roc.commands.work_build import add_layout_arguments, build_options
 from roc.workspace.selection import add_selection_arguments
@@ -28,7 +29,6 @@ def run(args: argparse.Namespace) -> int:
     from roc.build.plan import fingerprint_packages
     from roc.errors import UsageError
     from roc.workspace.load import load_workspace
-    from pathlib import Path
 
     if args.action != "key" and not args.path:
         raise UsageError(f"roc work cache {args.action} needs the cache directory: roc work cache {args.action} PATH")
@@ -46,16 +46,13 @@ def run(args: argparse.Namespace) -> int:
                               workspace.selected_in_order())
         print(f"exported {len(stored)} up-to-date package(s) to {cache}")
         return 0
-    from roc.build.layout import installed_in_order, prepare_build_base, prepare_install_base
-    from roc.shell.scripts import write_install_scripts
-    import os
+    from roc.build.layout import prepare_build_base, prepare_install_base, refresh_install_scripts
 
     prepare_build_base(options.build_base)
     prepare_install_base(options.install_base, merged=False)
     restored, left_out = import_cache(cache, workspace.root, options.build_base, options.install_base,
                                       {p.name: p for p in workspace.selected_in_order()})
-    underlays = [p for p in os.environ.get("COLCON_PREFIX_PATH", "").split(os.pathsep) if p]
-    write_install_scripts(options.install_base, installed_in_order(options.install_base, False), False, underlays)
+    refresh_install_scripts(options.install_base, merged=False)
     print(f"imported {len(restored)} package(s) from {cache}")
     for name, why in sorted(left_out.items()):
         print(f"  left out {name} (it will be rebuilt): {why}", file=sys.stderr)

@@ -20,7 +20,7 @@ from roc.errors import ManifestError
 from roc.messages import warn
 from roc.workspace.cmake_project import read_cmake_project
 from roc.workspace.manifest import parse_manifest
-from roc.workspace.package import CATEGORIES, IGNORE_MARKERS, Package
+from roc.workspace.package import CATEGORIES, Package
 from roc.workspace.python_setup import PythonProject, read_setup_cfg, read_setup_py, setup_cfg_is_sufficient
 
 # Files of catkin devel/install spaces and ament_tools install spaces, which hold no markers.
