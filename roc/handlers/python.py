@@ -43,7 +43,9 @@ def build_python(context: TaskContext, job: PackageJob, options: BuildOptions) -
     job.env["PYTHONPATH"] = os.pathsep.join(p for p in (str(lib), job.env.get("PYTHONPATH", "")) if p)
     record = job.build_dir / "install.log"
     command = [
-        sys.executable, "setup.py",
+        # setuptools' deprecation notices of these commands, silenced as colcon silences them
+        sys.executable, "-W", "ignore:setup.py install is deprecated", "-W", "ignore:easy_install command is deprecated",
+        "setup.py",
         "egg_info", "--egg-base", str(job.build_dir),
         "build", "--build-base", str(job.build_dir / "build"),
         "install", "--prefix", str(job.prefix), "--record", str(record), "--single-version-externally-managed",
