@@ -167,6 +167,14 @@ def _load_colcon_defaults(config: Configuration, root: Path, verb: str) -> None:
         config.add_layer(section, f"{path.name} [{verb}]", path, verb, None)
 
 
+def _check_package_setting(setting: Setting) -> None:
+    expected = PACKAGE_KEYS[setting.key]
+    value = setting.value
+    if not isinstance(value, expected) or (expected is list and not all(isinstance(v, str) for v in value)):
+        kind = "a list of strings" if expected is list else "true or false"
+        raise ConfigError(setting.path, setting.key, f"must be {kind}, not {value!r}", setting.line)
+
+
 def _load_colcon_meta(config: Configuration, path: Path) -> None:
     """colcon.meta's ``names`` section: per-package arguments (roc.toml's [package.NAME] wins)."""
     if not path.is_file():
@@ -179,12 +187,19 @@ def _load_colcon_meta(config: Configuration, path: Path) -> None:
         data = yaml.safe_load(path.read_text()) or {}
     except yaml.YAMLError as error:
         raise ConfigError(path, "(syntax)", f"invalid YAML: {getattr(error, 'problem', error)}") from None
-    for name, settings in (data.get("names") or {}).items() if isinstance(data, dict) else ():
+    names = data.get("names") if isinstance(data, dict) else None
+    if not isinstance(names or {}, dict):
+        raise ConfigError(path, "names", "must map package names to their settings")
+    for name, settings in (names or {}).items():
+        if not isinstance(settings or {}, dict):
+            raise ConfigError(path, str(name), "must map settings such as cmake-args to values")
         for key, value in (settings or {}).items():
             if key not in PACKAGE_KEYS:
                 warn(f"{path}: '{key}' of package '{name}' is not used by roc (it uses {', '.join(PACKAGE_KEYS)})")
                 continue
-            config.packages.setdefault(name, {})[key] = Setting(value, "colcon.meta", path, name, key, None)
+            setting = Setting(value, path.name, path, str(name), key, None)
+            _check_package_setting(setting)
+            config.packages.setdefault(str(name), {})[key] = setting
 
 
 def _load_roc_toml(config: Configuration, path: Path, verb: str, profile: str | None) -> None:
@@ -204,14 +219,22 @@ def _load_roc_toml(config: Configuration, path: Path, verb: str, profile: str | 
                               next((n for n, line in enumerate(text.splitlines(), 1) if f"[{table}" in line), None))
     config.add_layer(data.get("defaults", {}), f"{ROC_TOML} [defaults]", path, "defaults", text)
     config.add_layer(data.get(verb, {}), f"{ROC_TOML} [{verb}]", path, verb, text)
+    for table in ("package", "profile"):
+        for name, value in data.get(table, {}).items():
+            if not isinstance(value, dict):
+                raise ConfigError(path, f"{table}.{name}", f"must be a table: [{table}.{name}]",
+                                  _line_of(text, table, name))
     if profile:
         profiles = data.get("profile", {})
         if profile not in profiles:
             available = ", ".join(sorted(profiles)) or "none"
             raise UsageError(f"--profile {profile}: {path} has no [profile.{profile}] (profiles: {available})")
         chosen = profiles[profile]
-        shared = {k: v for k, v in chosen.items() if not isinstance(v, dict)}
+        shared = {k: v for k, v in chosen.items() if k not in VERBS}
         config.add_layer(shared, f"{ROC_TOML} [profile.{profile}]", path, f"profile.{profile}", text)
+        if not isinstance(chosen.get(verb, {}), dict):
+            raise ConfigError(path, f"profile.{profile}.{verb}", f"must be a table: [profile.{profile}.{verb}]",
+                              _line_of(text, f"profile.{profile}", verb))
         config.add_layer(chosen.get(verb, {}), f"{ROC_TOML} [profile.{profile}.{verb}]", path,
                          f"profile.{profile}.{verb}", text)
     for name, settings in data.get("package", {}).items():
@@ -219,12 +242,9 @@ def _load_roc_toml(config: Configuration, path: Path, verb: str, profile: str | 
         package = config.packages.setdefault(name, {})
         for key, value in settings.items():
             setting = Setting(value, f"{ROC_TOML} [{table}]", path, table, key, _line_of(text, table, key))
-            expected = PACKAGE_KEYS.get(key)
-            if expected is None:
+            if key not in PACKAGE_KEYS:
                 raise ConfigError(path, key, f"unknown package setting; use {', '.join(PACKAGE_KEYS)}", setting.line)
-            if not isinstance(value, expected) or (expected is list and not all(isinstance(v, str) for v in value)):
-                kind = "a list of strings" if expected is list else "true or false"
-                raise ConfigError(path, key, f"must be {kind}", setting.line)
+            _check_package_setting(setting)
             package[key] = setting
 
 

@@ -6,8 +6,19 @@ import os
 from pathlib import Path
 
 
+def _umask() -> int:
+    """The process umask (read once at import: os.umask can only be read by setting it)."""
+    current = os.umask(0o022)
+    os.umask(current)
+    return current
+
+
+UMASK = _umask()
+
+
 def write_text_atomic(path: Path, text: str, mode: int | None = None) -> None:
-    """Write ``text`` to ``path`` through a temporary file and a rename (never half-written)."""
+    """Write ``text`` to ``path`` through a temporary file and a rename (never half-written), with the
+    permissions a plain write would give (mkstemp makes private files)."""
     import tempfile  # not at module level: start-up stays light for read-only commands
 
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -15,8 +26,7 @@ def write_text_atomic(path: Path, text: str, mode: int | None = None) -> None:
     try:
         with os.fdopen(fd, "w") as handle:
             handle.write(text)
-        if mode is not None:
-            os.chmod(temporary, mode)
+        os.chmod(temporary, mode if mode is not None else 0o666 & ~UMASK)
         os.replace(temporary, path)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)

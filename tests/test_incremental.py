@@ -4,6 +4,7 @@ up-to-date package)."""
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 import time
@@ -98,12 +99,23 @@ def test_failed_build_is_never_up_to_date(built):
 
 
 def test_force_and_no_cache(built):
-    assert roc("work", "build", "--force", "--packages-select", "plain", cwd=built).returncode == 0
-    assert _built(built) == {"plain"}
-    state = built / "build" / "plain" / "roc_state.json"
-    before = state.read_text()
-    assert roc("work", "build", "--no-cache", "--packages-select", "plain", cwd=built).returncode == 0
-    assert _built(built) == {"plain"} and state.read_text() == before
+    forced = roc("work", "build", "--force", "--packages-select", "plain", cwd=built)
+    assert forced.returncode == 0 and _built(built) == {"plain"}, forced.stdout + forced.stderr
+    # --no-cache records nothing, and what it installs may differ from what the old fingerprint
+    # described: the next build must not trust that fingerprint.
+    main_c = built / "src" / "plain" / "main.c"
+    original = main_c.read_text()
+    main_c.write_text(original.replace("plain ok", "plain changed"))
+    try:
+        uncached = roc("work", "build", "--no-cache", "--packages-select", "plain", cwd=built)
+        assert uncached.returncode == 0 and _built(built) == {"plain"}, uncached.stdout + uncached.stderr
+    finally:
+        main_c.write_text(original)
+        later = main_c.stat().st_mtime_ns + 2_000_000_000  # make must see the restored file as newer
+        os.utime(main_c, ns=(later, later))
+    again = roc("work", "build", cwd=built)
+    assert again.returncode == 0 and _built(built) == {"plain"}, again.stdout + again.stderr
+    assert in_sourced_shell(built, "plain").stdout.strip() == "plain ok", again.stdout
 
 
 def test_concurrent_builds_wait_for_each_other(tmp_path):

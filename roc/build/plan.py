@@ -9,12 +9,12 @@ from pathlib import Path
 from collections.abc import Callable
 
 from roc.build.finish import finish_package
-from roc.build.fingerprint import combine, source_digest, toolchain_digest
+from roc.build.fingerprint import combine, external_stamp, source_digest, toolchain_digest, underlay_prefixes
 from roc.build.state import install_intact, read_state, write_state
 from roc.build.layout import package_prefix
 from roc.engine.graph import Task
 from roc.engine.jobserver import Jobserver
-from roc.engine.process import TaskContext, TaskError
+from roc.engine.process import TaskContext
 from roc.environment.dsv import apply_operations, resolve_operations
 from roc.fsutil import write_text_atomic
 from roc.handlers.cmake import build_cmake
@@ -91,7 +91,10 @@ def fingerprint_packages(workspace: Workspace, options: BuildOptions) -> dict[st
     """Fingerprints of the selected packages, in topological order. A package that is not selected
     counts with the fingerprint of its last successful build (what is installed), if known."""
     by_name = workspace.by_name
-    toolchain = toolchain_digest(base_environment(), options.install_base)
+    environment = base_environment()
+    toolchain = toolchain_digest(environment, options.install_base)
+    prefixes = underlay_prefixes(environment, options.install_base)
+    external: dict[str, str | None] = {}
     fingerprints: dict[str, str | None] = {}
     states: dict[str, PackageState] = {}
     for package in workspace.ordered:
@@ -101,9 +104,13 @@ def fingerprint_packages(workspace: Workspace, options: BuildOptions) -> dict[st
             continue
         sources, files = source_digest((workspace.root / package.path).resolve(), state.get("files", {}))
         recursive = recursive_dependencies(package, by_name)
+        for name in package.direct_dependencies() - by_name.keys():
+            if name not in external:
+                external[name] = external_stamp(name, prefixes)
         fingerprint = combine({
             "sources": sources, "options": _options_digest(package, options), "toolchain": toolchain,
             "dependencies": {n: fingerprints.get(n) for n in sorted(recursive)},
+            "underlay": {n: external[n] for n in sorted(package.direct_dependencies() - by_name.keys())},
         })
         fingerprints[package.name] = fingerprint
         states[package.name] = PackageState(fingerprint, state.get("fingerprint"), files)
@@ -119,8 +126,6 @@ def plan_build(
     states = fingerprint_packages(workspace, options) if options.use_state else {}
     tasks = []
     for package in workspace.selected_in_order():
-        if package.type not in HANDLERS:
-            raise TaskError(f"{package.path}: build type '{package.type}' is not supported by roc yet")
         recursive = recursive_dependencies(package, by_name)
         dependencies = [n for n in order if n in recursive]
         prefix = package_prefix(options.install_base, package.name, options.merge_install)
@@ -154,8 +159,9 @@ def _package_action(package: Package, source: Path, prefix: Path, dependencies: 
             job.make_flags = jobserver.makeflags(env.get("MAKEFLAGS", ""))
             job.pass_fds = jobserver.fds
         job.build_dir.mkdir(parents=True, exist_ok=True)
-        if options.use_state:  # until it succeeds, the package is not up to date
-            write_state(job.build_dir, None, files)
+        # Until it succeeds (and even with --no-cache, which records no new one), no old fingerprint
+        # may vouch for what this build is about to install.
+        write_state(job.build_dir, None, files)
         write_text_atomic(job.build_dir / ENVIRONMENT_FILE, json.dumps(env, indent=1, sort_keys=True))
         HANDLERS[package.type](context, job, options)
         finish_package(package, job.prefix)

@@ -134,7 +134,9 @@ def main(argv: list[str] | None = None) -> int:
     debug = os.environ.get("ROC_DEBUG") == "1" or "--debug" in (argv if argv is not None else sys.argv[1:])
     try:
         argv = list(sys.argv[1:] if argv is None else argv)
-        directory = _early_value(argv[: argv.index("work")] if "work" in argv else argv, "-C")
+        first_word = next((i for i, w in enumerate(argv) if not w.startswith("-") and (i == 0 or argv[i - 1] != "-C")),
+                          len(argv))
+        directory = _early_value(argv[:first_word], "-C")
         if directory:
             try:
                 os.chdir(directory)
@@ -169,6 +171,12 @@ def main(argv: list[str] | None = None) -> int:
         # The reader went away (e.g. `roc work list | head`): not an error worth a message.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except OSError as error:  # a path roc cannot create, read or write
+        if debug:
+            raise
+        where = f"{error.filename}: " if error.filename else ""
+        print(f"roc: error: {where}{error.strerror or error}; check the path and its permissions", file=sys.stderr)
+        return EXIT_FAILURE
     except Exception as error:  # noqa: BLE001 - last resort: one line, details with --debug
         if debug:
             raise

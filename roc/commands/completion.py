@@ -41,8 +41,8 @@ def command_tree(parser: argparse.ArgumentParser, path: tuple[str, ...] = ()) ->
 
 
 def all_options(parser: argparse.ArgumentParser) -> set[str]:
-    """Every option string of every command."""
-    return {option for _, options, _ in command_tree(parser).values() for option in options}
+    """Every option string of every command (not the global ones such as -C, which only go before it)."""
+    return {option for path, (_, options, _) in command_tree(parser).items() if path for option in options}
 
 
 def _case_key(path: tuple[str, ...]) -> str:

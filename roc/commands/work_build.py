@@ -57,6 +57,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_selection_arguments(parser)
 
 
+class AppendToCommandLine(argparse._AppendAction):
+    """``append``, except that the first value given on the command line replaces a default list from
+    roc.toml or colcon's defaults instead of adding to it (the command line wins, as in colcon)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        marker = f"_given_{self.dest}"
+        if not getattr(namespace, marker, False):
+            setattr(namespace, self.dest, [])
+            setattr(namespace, marker, True)
+        super().__call__(parser, namespace, values, option_string)
+
+
 def add_layout_arguments(parser: argparse.ArgumentParser) -> None:
     """The options that decide where packages go and what their fingerprints are (build and cache)."""
     add = parser.add_argument
@@ -67,9 +79,10 @@ def add_layout_arguments(parser: argparse.ArgumentParser) -> None:
     add("--install-base", default="install", help="base directory of the install prefixes (default: install)")
     add("--merge-install", action="store_true", help="install all packages into one prefix")
     add("--symlink-install", action="store_true", help="symlink installed files to the sources where possible")
-    add("--cmake-args", action="append", default=[], metavar="ARG",
+    add("--cmake-args", action=AppendToCommandLine, default=[], metavar="ARG",
         help="arguments for CMake (values may start with '-')")
-    add("--ament-cmake-args", action="append", default=[], metavar="ARG", help="arguments for ament_cmake packages")
+    add("--ament-cmake-args", action=AppendToCommandLine, default=[], metavar="ARG",
+        help="arguments for ament_cmake packages")
 
 
 def build_options(args: argparse.Namespace, root: Path, **extra):
@@ -86,6 +99,18 @@ def build_options(args: argparse.Namespace, root: Path, **extra):
         package_cmake_args=per_package["cmake-args"], package_ament_cmake_args=per_package["ament-cmake-args"],
         **extra,
     )
+
+
+def skip_unbuildable_packages(workspace) -> None:
+    """Packages of a build type roc has no handler for are skipped with a warning, as colcon does."""
+    from roc.build.plan import HANDLERS
+    from roc.messages import warn
+
+    for package in workspace.selected_in_order():
+        if package.type not in HANDLERS:
+            warn(f"{package.path}: no way to build '{package.name}' of type '{package.type}' "
+                 f"(roc builds {', '.join(sorted(HANDLERS))}); skipped")
+            workspace.selected.discard(package.name)
 
 
 def skip_configured_packages(args: argparse.Namespace, workspace) -> None:
@@ -143,11 +168,14 @@ def run(args: argparse.Namespace) -> int:
         args.packages_up_to = [*(args.packages_up_to or []), *args.packages]
     if args.parallel_workers < 0:
         raise UsageError("--parallel-workers must be 0 (no limit) or more")
+    if args.jobs is not None and args.jobs < 1:
+        raise UsageError("-j/--jobs must be 1 or more")
     from roc.build.lock import build_lock
     from roc.engine.jobserver import jobs_from_makeflags
 
     workspace = load_workspace(args)
     skip_configured_packages(args, workspace)
+    skip_unbuildable_packages(workspace)
     jobs = args.jobs or jobs_from_makeflags(os.environ.get("MAKEFLAGS", "")) or os.cpu_count() or 1
     options = build_options(
         args, workspace.root, cmake_target=args.cmake_target,
@@ -207,6 +235,8 @@ def _build(args, workspace, options, switches: dict[str, bool]) -> int:
         result = execute(tasks, handlers, workers, continue_on_error=args.continue_on_error)
     finally:
         jobserver.close()
+        for handler in handlers:  # e.g. the terminal's live line, when the run ended by an error
+            getattr(handler, "close", lambda: None)()
     durations.save()
     refresh_install_scripts(options.install_base, args.merge_install)
     if result.interrupted:

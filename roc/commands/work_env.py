@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import shlex
 import sys
 
@@ -52,7 +53,9 @@ def run(args: argparse.Namespace) -> int:
     if args.format == "json":
         print_json(env)
     else:
-        sys.stdout.write("".join(f"export {name}={shlex.quote(value)}\n" for name, value in sorted(env.items())))
+        # Only names a shell can export (not e.g. BASH_FUNC_f%% of exported bash functions).
+        sys.stdout.write("".join(f"export {name}={shlex.quote(value)}\n" for name, value in sorted(env.items())
+                                 if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name)))
     return 0
 
 

@@ -76,6 +76,7 @@ class RunFinished(Event):
     """The whole run ended; ``task`` is empty."""
 
     interrupted: bool = False
+    not_started: tuple[str, ...] = ()  # never started: the run stopped first
 
 
 @dataclass(frozen=True)

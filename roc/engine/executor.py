@@ -56,14 +56,6 @@ def _work(task: Task, context: TaskContext) -> None:
         context.emit(TaskFinished(task.name, duration=time.monotonic() - start, cached=bool(cached)))
 
 
-class _Terminated(Exception):
-    pass
-
-
-def _raise_terminated(signum, frame):  # noqa: ARG001
-    raise _Terminated
-
-
 def execute(
     tasks: Iterable[Task],
     handlers: Iterable[Handler],
@@ -114,46 +106,64 @@ def execute(
         if isinstance(event, (TaskFinished, TaskFailed, TaskAbortedEvent)):
             running.pop(event.task, None)
 
-    previous_sigterm = signal.signal(signal.SIGTERM, _raise_terminated) \
-        if threading.current_thread() is threading.main_thread() else None
+    interrupt = threading.Event()
+
+    def on_signal(signum, frame) -> None:  # noqa: ARG001
+        # Only note it: raising here could leave a started task unaccounted for.
+        interrupt.set()
+        events.put(Tick(""))
+
+    previous = {}
+    if threading.current_thread() is threading.main_thread():
+        previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
     pool = ThreadPoolExecutor(max_workers=limit, thread_name_prefix="roc-worker")
-    try:
-        for name in by_name:
-            dispatch(TaskQueued(name))
-        while True:
-            try:
-                while not stopping and ready.has_ready() and len(running) < limit:
-                    task = ready.pop()
-                    if task.up_to_date:
-                        event = TaskFinished(task.name, cached=True)
-                        dispatch(event)
-                        settle(event)
-                        continue
-                    context = TaskContext(task.name, events.put)
-                    running[task.name] = context
-                    pool.submit(_work, task, context)
-                if not running:
-                    break
-                try:
-                    event = events.get(timeout=TICK_SECONDS)
-                except queue.Empty:
-                    dispatch(Tick(""))
-                    continue
-                dispatch(event)
-                settle(event)
-            except (KeyboardInterrupt, _Terminated):
-                result.interrupted = True
+    failure: BaseException | None = None
+
+    def handle(event: Event) -> None:
+        """Handlers see the event; the run's bookkeeping happens even if one of them fails."""
+        nonlocal failure, stopping
+        try:
+            dispatch(event)
+        except Exception as error:  # e.g. stdout closed under a JSON consumer: stop, then report it
+            if failure is None:
+                failure = error
+            if not stopping:
                 stopping = True
                 stop_running()
+        finally:
+            settle(event)
+
+    try:
+        for name in by_name:
+            handle(TaskQueued(name))
+        while True:
+            if interrupt.is_set() and not result.interrupted:
+                result.interrupted = stopping = True
+                stop_running()
+            while not stopping and ready.has_ready() and len(running) < limit:
+                task = ready.pop()
+                if task.up_to_date:
+                    handle(TaskFinished(task.name, cached=True))
+                    continue
+                context = TaskContext(task.name, events.put)
+                pool.submit(_work, task, context)
+                running[task.name] = context
+            if not running:
+                break
+            try:
+                event = events.get(timeout=TICK_SECONDS)
+            except queue.Empty:
+                event = Tick("")
+            handle(event)
     finally:
         pool.shutdown(wait=True)
         while not events.empty():  # events emitted by the last workers while shutting down
-            event = events.get()
-            dispatch(event)
-            settle(event)
-        if previous_sigterm is not None:
-            signal.signal(signal.SIGTERM, previous_sigterm)
+            handle(events.get())
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     done = set(result.finished) | set(result.failed) | set(result.aborted) | set(result.skipped)
     result.not_started = [n for n in by_name if n not in done]
-    dispatch(RunFinished("", interrupted=result.interrupted))
+    handle(RunFinished("", interrupted=result.interrupted, not_started=tuple(result.not_started)))
+    if failure is not None:
+        raise failure
     return result

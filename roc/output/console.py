@@ -48,6 +48,12 @@ class ConsoleHandler:
         self.aborted: list[str] = []
         self.skipped: dict[str, str] = {}
 
+    def close(self) -> None:
+        """Give the terminal back (the live status line) if the run ended without RunFinished."""
+        if self.status is not None:
+            self.status.live.stop()
+            self.status = None
+
     def _print(self, text: str) -> None:
         if self.status is not None:
             self.status.print(text)
@@ -117,6 +123,8 @@ class ConsoleHandler:
         with_stderr = sorted(self._stderr)
         if with_stderr:
             lines.append(f"  {_count(len(with_stderr))} had stderr output: {' '.join(with_stderr)}")
+        if event.not_started:
+            lines.append(f"  {_count(len(event.not_started))} not processed")
         if event.interrupted:
             lines.append("  interrupted by the user")
         self._print("\n".join(lines))

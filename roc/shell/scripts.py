@@ -6,6 +6,7 @@ resolved operations into plain shell, so sourcing needs no Python and no per-pac
 
 from __future__ import annotations
 
+import re
 import shlex
 from functools import lru_cache
 from pathlib import Path
@@ -25,6 +26,8 @@ def _templates():
         undefined=jinja2.StrictUndefined, autoescape=False,
     )
     environment.filters["shquote"] = lambda value: shlex.quote(str(value))
+    # for values inside "...": keeps spaces and any characters, expands nothing
+    environment.filters["dquote"] = lambda value: re.sub(r'([\\"$`])', r"\\\1", str(value))
     return environment
 
 

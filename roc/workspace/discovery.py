@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import glob
 import os
+import re
 from pathlib import Path
 from collections.abc import Iterable, Mapping
 
@@ -66,6 +67,7 @@ def discover_packages(
         if package:
             found[real] = package
     packages = sorted(found.values(), key=lambda p: (p.name, str(p.path)))
+    _check_names(packages)
     _check_duplicates(packages)
     _resolve_groups(packages)
     return packages
@@ -94,6 +96,19 @@ def _crawl(start: Path, shown_base: Path, variables, found: dict[str, Package], 
             dirnames.clear()
             continue
         dirnames[:] = sorted(d for d in dirnames if not d.startswith("."))
+
+
+# Names become directory names and go into shell scripts: no separators, spaces or shell syntax.
+_VALID_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.+-]*")
+
+
+def _check_names(packages: list[Package]) -> None:
+    for package in packages:
+        if not _VALID_NAME.fullmatch(package.name):
+            raise RocError(
+                f"{package.path}: package name '{package.name}' is not usable; names may hold letters, "
+                "digits and _ . + - only (see the name in its package.xml, CMakeLists.txt, setup.py or colcon.pkg)"
+            )
 
 
 def _check_duplicates(packages: list[Package]) -> None:
