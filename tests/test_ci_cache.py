@@ -81,4 +81,4 @@ def test_bad_usage(tmp_path):
     missing_path = roc("work", "cache", "export", cwd=ws)
     assert missing_path.returncode == 2 and "needs the cache directory" in missing_path.stderr
     not_a_cache = roc("work", "cache", "import", str(tmp_path), cwd=ws)
-    assert not_a_cache.returncode == 1 and "not a roc cache" in not_a_cache.stderr
+    assert not_a_cache.returncode == 1 and "not a usable roc cache" in not_a_cache.stderr

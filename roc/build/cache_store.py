@@ -38,16 +38,21 @@ REWRITABLE_DIRS = ("parent_prefix_path",)
 REGENERATED = ("package.sh", "package.bash", "package.zsh")
 
 
+def _links_outside(prefix: Path) -> bool:
+    """A --symlink-install prefix points into its sources: not something to restore elsewhere."""
+    return any(path.is_symlink() and os.path.isabs(os.readlink(path)) for path in prefix.rglob("*"))
+
+
 def export_cache(destination: Path, root: Path, build_base: Path, install_base: Path,
                  packages: list[Package]) -> list[str]:
-    """Store every given package that is up to date; returns the names stored."""
+    """Store every given package that is up to date (not symlink-installed ones); returns the names stored."""
     objects = destination / "objects"
     objects.mkdir(parents=True, exist_ok=True)
     entries = {}
     for package in packages:
         build_dir, prefix = build_base / package.name, install_base / package.name
         fingerprint = read_state(build_dir).get("fingerprint")
-        if not fingerprint or not install_intact(prefix, package.name, build_dir):
+        if not fingerprint or not install_intact(prefix, package.name, build_dir) or _links_outside(prefix):
             continue
         archive = objects / f"{fingerprint}.tar.gz"
         if not archive.exists():
@@ -90,14 +95,32 @@ def _relocate(tree: Path, replacements: dict[bytes, bytes]) -> str | None:
     return None
 
 
+def _read_index(source: Path) -> dict:
+    """The cache's index, checked for the shape export writes (anything else is not trusted)."""
+    problem = None
+    try:
+        index = json.loads((source / INDEX).read_text())
+    except (OSError, ValueError) as error:
+        problem = str(error)
+    else:
+        strings = ("workspace", "install_base", "build_base")
+        if not isinstance(index, dict) or not all(isinstance(index.get(k), str) for k in strings):
+            problem = "its index.json lacks the workspace, install_base or build_base paths"
+        elif not isinstance(index.get("packages"), dict) or not all(
+                isinstance(entry, dict) and isinstance(entry.get("fingerprint"), str)
+                and re.fullmatch(r"[0-9a-f]{64}", entry["fingerprint"]) and isinstance(entry.get("sha256"), str)
+                for entry in index["packages"].values()):
+            problem = "its index.json has malformed package entries"
+    if problem:
+        raise RocError(f"{source}: not a usable roc cache ({problem}); make one with 'roc work cache export'")
+    return index
+
+
 def import_cache(source: Path, root: Path, build_base: Path, install_base: Path,
                  packages: dict[str, Package]) -> tuple[list[str], dict[str, str]]:
     """Restore the cached packages that exist in this workspace; returns (restored, left out: why)."""
-    try:
-        index = json.loads((source / INDEX).read_text())
-        entries = index["packages"]
-    except (OSError, ValueError, KeyError) as error:
-        raise RocError(f"{source}: not a roc cache ({error}); make one with 'roc work cache export'") from None
+    index = _read_index(source)
+    entries = index["packages"]
     replacements = {index[key].encode(): str(new).encode() for key, new in
                     (("install_base", install_base), ("build_base", build_base), ("workspace", root))}
     restored: list[str] = []
@@ -128,7 +151,8 @@ def _restore(archive: Path, name: str, package: Package, replacements, build_bas
         except (tarfile.TarError, OSError, EOFError) as error:
             warn(f"{archive}: unreadable cache entry ({error}); '{name}' will be rebuilt")
             return "its cache entry is unreadable"
-        depends_on_path = _relocate(tree, replacements)
+        moved = any(old != new for old, new in replacements.items())
+        depends_on_path = _relocate(tree, replacements) if moved else None
         if depends_on_path:
             return f"{depends_on_path} holds the absolute path it was built at"
         prefix, build_dir = install_base / name, build_base / name
@@ -142,6 +166,6 @@ def _restore(archive: Path, name: str, package: Package, replacements, build_bas
     return None
 
 
-def check_isolated(install_base: Path, merge_install: bool) -> None:
+def check_isolated(merge_install: bool) -> None:
     if merge_install:
         raise UsageError("roc work cache supports the isolated install layout only (no --merge-install)")

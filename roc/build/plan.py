@@ -139,8 +139,8 @@ def plan_build(
         tasks.append(Task(
             name=package.name,
             dependencies={n for n in dependencies if n in selected},
-            action=_package_action(package, source, prefix, dependencies, options, jobserver,
-                                   (fingerprint, state.files)),
+            action=_package_action(package, source, prefix, dependencies, options, jobserver, fingerprint,
+                                   state.files),
             weight=weights.get(package.name, 1.0),
             up_to_date=up_to_date,
         ))
@@ -148,9 +148,7 @@ def plan_build(
 
 
 def _package_action(package: Package, source: Path, prefix: Path, dependencies: list[str], options: BuildOptions,
-                    jobserver: Jobserver | None, fingerprint_and_files: tuple[str | None, dict]):
-    fingerprint, files = fingerprint_and_files
-
+                    jobserver: Jobserver | None, fingerprint: str | None, files: dict):
     def action(context: TaskContext) -> None:
         env = build_environment(package, dependencies, options)
         job = PackageJob(package=package, source=source, build_dir=options.build_base / package.name,

@@ -199,7 +199,7 @@ def _output_handlers(args, switches: dict[str, bool], root: Path, build_base: Pa
     log_dir = None
     if args.log_base != os.devnull and switches.get("log", True):
         log_dir = new_log_directory((root / args.log_base).absolute())
-        handlers.append(LogHandler(log_dir))
+        handlers.append(LogHandler(log_dir, events=switches.get("event_log", True)))
     if switches.get("store_result", True):
         handlers.append(ResultStore(build_base))
     if args.output == "json":

@@ -39,7 +39,7 @@ def run(args: argparse.Namespace) -> int:
         data = json.dumps({name: state.fingerprint for name, state in sorted(states.items())})
         print(f"roc-{hashlib.sha256(data.encode()).hexdigest()[:40]}")
         return 0
-    check_isolated(options.install_base, options.merge_install)
+    check_isolated(options.merge_install)
     cache = Path(args.path).absolute()
     if args.action == "export":
         stored = export_cache(cache, workspace.root, options.build_base, options.install_base,
@@ -48,12 +48,15 @@ def run(args: argparse.Namespace) -> int:
         return 0
     from roc.build.layout import prepare_build_base, prepare_install_base, refresh_install_scripts
 
-    prepare_build_base(options.build_base)
-    prepare_install_base(options.install_base, merged=False)
-    restored, left_out = import_cache(cache, workspace.root, options.build_base, options.install_base,
-                                      {p.name: p for p in workspace.selected_in_order()})
-    refresh_install_scripts(options.install_base, merged=False)
+    from roc.build.lock import build_lock
+
+    with build_lock(options.build_base):  # never replace a prefix while a build uses it
+        prepare_build_base(options.build_base)
+        prepare_install_base(options.install_base, merged=False)
+        restored, left_out = import_cache(cache, workspace.root, options.build_base, options.install_base,
+                                          {p.name: p for p in workspace.selected_in_order()})
+        refresh_install_scripts(options.install_base, merged=False)
     print(f"imported {len(restored)} package(s) from {cache}")
     for name, why in sorted(left_out.items()):
-        print(f"  left out {name} (it will be rebuilt): {why}", file=sys.stderr)
+        print(f"  not restored: {name}: {why} (the next build builds it if needed)", file=sys.stderr)
     return 0

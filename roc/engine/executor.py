@@ -15,11 +15,11 @@ from dataclasses import dataclass, field
 from collections.abc import Callable, Iterable
 
 from roc.engine.events import (
-    Event, RunFinished, TaskAborted as TaskAbortedEvent, TaskFailed, TaskFinished, TaskQueued, TaskSkipped,
+    Event, RunFinished, TaskAborted, TaskFailed, TaskFinished, TaskQueued, TaskSkipped,
     TaskStarted, Tick,
 )
 from roc.engine.graph import ReadyQueue, Task
-from roc.engine.process import TaskAborted, TaskContext, TaskError
+from roc.engine.process import TaskCancelled, TaskContext, TaskError
 
 Handler = Callable[[Event], None]
 TICK_SECONDS = 0.25
@@ -44,10 +44,10 @@ def _work(task: Task, context: TaskContext) -> None:
     start = time.monotonic()
     try:
         if context.cancelled:
-            raise TaskAborted
+            raise TaskCancelled
         cached = task.action(context)
-    except TaskAborted:
-        context.emit(TaskAbortedEvent(task.name, duration=time.monotonic() - start))
+    except TaskCancelled:
+        context.emit(TaskAborted(task.name, duration=time.monotonic() - start))
     except TaskError as error:
         context.emit(TaskFailed(task.name, duration=time.monotonic() - start, reason=str(error)))
     except Exception:  # noqa: BLE001 - a bug in an action must fail its task, not hang the run
@@ -101,9 +101,9 @@ def execute(
             elif not stopping:
                 stopping = True
                 stop_running()
-        elif isinstance(event, TaskAbortedEvent):
+        elif isinstance(event, TaskAborted):
             result.aborted.append(event.task)
-        if isinstance(event, (TaskFinished, TaskFailed, TaskAbortedEvent)):
+        if isinstance(event, (TaskFinished, TaskFailed, TaskAborted)):
             running.pop(event.task, None)
 
     interrupt = threading.Event()

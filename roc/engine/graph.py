@@ -56,9 +56,6 @@ class ReadyQueue:
             raise ValueError("the task graph has a cycle")
         return order
 
-    def priority(self, name: str) -> float:
-        return self._priority[name]
-
     def has_ready(self) -> bool:
         return bool(self._ready)
 

@@ -17,7 +17,7 @@ class TaskError(Exception):
     """The task failed; the message says why (shown in the summary)."""
 
 
-class TaskAborted(Exception):
+class TaskCancelled(Exception):
     """The task was stopped from outside (another task failed, or Ctrl+C)."""
 
 
@@ -69,11 +69,11 @@ class TaskContext:
         env: Mapping[str, str],
         pass_fds: Sequence[int] = (),
     ) -> int:
-        """Run ``command``, emitting its output; returns the exit code, raises TaskAborted if cancelled."""
+        """Run ``command``, emitting its output; returns the exit code, raises TaskCancelled if cancelled."""
         command = tuple(str(part) for part in command)
         with self._lock:
             if self.cancelled:
-                raise TaskAborted
+                raise TaskCancelled
             self.emit(CommandStarted(self.name, command=command, cwd=str(cwd)))
             try:
                 process = subprocess.Popen(
@@ -90,7 +90,7 @@ class TaskContext:
             cancelled = self.cancelled
         self.emit(CommandEnded(self.name, command=command, returncode=returncode))
         if cancelled:
-            raise TaskAborted
+            raise TaskCancelled
         return returncode
 
     def _pump(self, process: subprocess.Popen) -> None:

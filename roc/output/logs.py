@@ -45,9 +45,11 @@ def new_log_directory(log_base: Path, verb: str = "build") -> Path:
 
 
 class LogHandler:
-    def __init__(self, directory: Path):
+    """Per-package logs, and (unless ``event_log-``) every event in ``events.log``."""
+
+    def __init__(self, directory: Path, events: bool = True):
         self.directory = directory
-        self._events = open(directory / "events.log", "a", buffering=1)
+        self._events = open(directory / "events.log", "a", buffering=1) if events else None
         self._files: dict[tuple[str, str], object] = {}
 
     def _file(self, task: str, name: str):
@@ -72,7 +74,8 @@ class LogHandler:
             text = f"Invoked command '{shlex.join(event.command)}' returned '{event.returncode}'\n".encode()
             self._file(event.task, "command.log").write(text)
             self._file(event.task, "streams.log").write(text)
-        self._events.write(event_json(event) + "\n")
+        if self._events is not None:
+            self._events.write(event_json(event) + "\n")
         if isinstance(event, RunFinished):
             self.close()
 
@@ -80,7 +83,8 @@ class LogHandler:
         for handle in self._files.values():
             handle.close()
         self._files.clear()
-        self._events.close()
+        if self._events is not None:
+            self._events.close()
 
 
 class ResultStore:
