@@ -4,7 +4,6 @@ up-to-date package)."""
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import subprocess
 import time
@@ -44,6 +43,7 @@ def test_noop_rebuild_runs_no_tool(built):
 def test_edit_rebuilds_the_package_and_its_dependents_only(built):
     source = built / "src" / "core" / "src" / "core.cpp"
     original = source.read_text()
+    time.sleep(1.1)  # CMake's install compares timestamps to the second
     source.write_text(original.replace("42", "43"))
     try:
         assert roc("work", "build", cwd=built).returncode == 0
@@ -105,14 +105,15 @@ def test_force_and_no_cache(built):
     # described: the next build must not trust that fingerprint.
     main_c = built / "src" / "plain" / "main.c"
     original = main_c.read_text()
+    # CMake's install compares timestamps to the second: keep the builds a second apart.
+    time.sleep(1.1)
     main_c.write_text(original.replace("plain ok", "plain changed"))
     try:
         uncached = roc("work", "build", "--no-cache", "--packages-select", "plain", cwd=built)
         assert uncached.returncode == 0 and _built(built) == {"plain"}, uncached.stdout + uncached.stderr
     finally:
+        time.sleep(1.1)
         main_c.write_text(original)
-        later = main_c.stat().st_mtime_ns + 2_000_000_000  # make must see the restored file as newer
-        os.utime(main_c, ns=(later, later))
     again = roc("work", "build", cwd=built)
     assert again.returncode == 0 and _built(built) == {"plain"}, again.stdout + again.stderr
     assert in_sourced_shell(built, "plain").stdout.strip() == "plain ok", again.stdout

@@ -7,6 +7,7 @@ import os
 import shlex
 import stat
 import subprocess
+import time
 
 import pytest
 
@@ -51,6 +52,7 @@ def test_changed_underlay_rebuilds_the_overlay(tmp_path):
     assert in_sourced_shell(overlay, build, setup="/dev/null", strict=False).returncode == 0
     again = in_sourced_shell(overlay, build, setup="/dev/null", strict=False)
     assert "1 package up to date" in again.stdout
+    time.sleep(1.1)  # CMake's install compares timestamps to the second
     (underlay / "src" / "lib_a" / "value.txt").write_text("v2")
     assert roc("work", "build", cwd=underlay).returncode == 0
     rebuilt = in_sourced_shell(overlay, build, setup="/dev/null", strict=False)
@@ -65,6 +67,7 @@ def test_symlinked_sources_are_tracked(tmp_path):
     value.unlink()
     value.symlink_to(shared)
     assert roc("work", "build", cwd=tmp_path / "ws").returncode == 0
+    time.sleep(1.1)  # CMake's install compares timestamps to the second
     shared.write_text("v2")
     result = roc("work", "build", cwd=tmp_path / "ws")
     assert "Finished <<< alpha" in result.stdout
