@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import pytest
 
-from build_helpers import roc
+from build_helpers import BIN, roc, ros_env
 
 SHOW_MAKEFLAGS = """cmake_minimum_required(VERSION 3.8)
 project({name} C)
@@ -103,3 +104,21 @@ def test_env_prints_and_runs_the_build_environment(ws):
     assert ran.returncode == 0 and ran.stdout.strip() and "using workspace root" in ran.stderr
     unknown = roc("work", "env", "gamma", cwd=ws)
     assert unknown.returncode == 2 and "gamma" in unknown.stderr
+
+
+@pytest.mark.skipif(shutil.which("ninja", path=str(BIN)) is None and shutil.which("ninja") is None,
+                    reason="ninja is not installed")
+def test_cmake_generator_is_respected(tmp_path):
+    ws = tmp_path
+    for name in ("alpha", "beta"):
+        (ws / "src" / name).mkdir(parents=True)
+        (ws / "src" / name / "CMakeLists.txt").write_text(
+            f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n"
+            f"install(FILES CMakeLists.txt DESTINATION share/{name})\n")
+    env = {**ros_env(), "CMAKE_GENERATOR": "Ninja"}
+    result = roc("work", "build", "-j", "4", "--parallel-workers", "2", cwd=ws, env=env)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert (ws / "build" / "alpha" / "build.ninja").is_file()
+    # ninja cannot join the make jobserver: each of the 2 packages gets half of the budget of 4
+    assert "--build" in _commands(ws, "alpha") and "-- -j2" in _commands(ws, "alpha")
+    assert (ws / "install" / "alpha" / "share" / "alpha" / "CMakeLists.txt").is_file()

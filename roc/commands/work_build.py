@@ -177,11 +177,13 @@ def run(args: argparse.Namespace) -> int:
     skip_configured_packages(args, workspace)
     skip_unbuildable_packages(workspace)
     jobs = args.jobs or jobs_from_makeflags(os.environ.get("MAKEFLAGS", "")) or os.cpu_count() or 1
+    workers = 1 if args.executor == "sequential" else args.parallel_workers or len(workspace.selected) or 1
     options = build_options(
         args, workspace.root, cmake_target=args.cmake_target,
         cmake_target_skip_unavailable=args.cmake_target_skip_unavailable,
         cmake_clean_cache=args.cmake_clean_cache, cmake_clean_first=args.cmake_clean_first,
-        cmake_force_configure=args.cmake_force_configure, jobs=jobs, force=args.force,
+        cmake_force_configure=args.cmake_force_configure, jobs=jobs, jobs_per_package=max(1, jobs // workers),
+        force=args.force,
         use_state=not args.no_cache,
     )
     with build_lock(options.build_base):

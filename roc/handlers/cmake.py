@@ -95,6 +95,6 @@ def _build_command(job: PackageJob, options: BuildOptions, target: str) -> list[
     if target:
         command += ["--target", target]
     if "Ninja" in generator or generator == "Unix Makefiles":
-        command += ["--", f"-j{options.jobs}"]
+        command += ["--", f"-j{options.jobs_per_package}"]
     return command
 

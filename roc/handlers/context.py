@@ -23,7 +23,8 @@ class BuildOptions:
     cmake_clean_cache: bool = False
     cmake_clean_first: bool = False
     cmake_force_configure: bool = False
-    jobs: int = 2
+    jobs: int = 2  # the global budget, shared through the make jobserver
+    jobs_per_package: int = 2  # for build tools that cannot join the jobserver (ninja): an equal share
     # Per-package additions (roc.toml [package.NAME], colcon.meta), appended to the common arguments.
     package_cmake_args: dict[str, tuple[str, ...]] = field(default_factory=dict)
     package_ament_cmake_args: dict[str, tuple[str, ...]] = field(default_factory=dict)
