@@ -10,6 +10,7 @@ import sys
 
 from roc.cli.output import add_format_argument, print_json
 from roc.errors import UsageError
+from roc.workspace.selection import add_selection_arguments
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -20,6 +21,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--install-base", default="install", help="install base (default: install)")
     parser.add_argument("--merge-install", action="store_true", help="the install base has the merged layout")
     add_format_argument(parser)
+    add_selection_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -34,8 +36,7 @@ def run(args: argparse.Namespace) -> int:
     if env is None:  # not built yet: what it would be built in now
         from roc.workspace.load import load_workspace
 
-        args.base_paths = args.paths = None
-        workspace = load_workspace(_selection_defaults(args))
+        workspace = load_workspace(args)
         package = workspace.by_name.get(args.package)
         if package is None:
             raise UsageError(f"no package named '{args.package}' in the workspace; see 'roc work list -n'")
@@ -58,14 +59,3 @@ def run(args: argparse.Namespace) -> int:
                                  if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name)))
     return 0
 
-
-def _selection_defaults(args: argparse.Namespace) -> argparse.Namespace:
-    """This command has no selection options; give the loader their defaults."""
-    parser = argparse.ArgumentParser()
-    from roc.workspace.selection import add_selection_arguments
-
-    add_selection_arguments(parser)
-    defaults = parser.parse_args([])
-    for key, value in vars(args).items():
-        setattr(defaults, key, value)
-    return defaults
