@@ -62,6 +62,17 @@ def installed_files(install: Path) -> set[str]:
     return {str(p.relative_to(install)) for p in install.rglob("*") if not p.is_dir()}
 
 
+def comparable_install_files(install: Path) -> set[str]:
+    """Installed files less the justified differences between roc and colcon: colcon's Python helpers
+    for its setup scripts (roc bakes the order into the scripts) and byte-code caches (they depend on
+    who imported what)."""
+    return {f for f in installed_files(install) if not f.endswith(".pyc") and "_local_setup_util_" not in f}
+
+
+def package_dsv_files(install: Path) -> dict[str, str]:
+    return {str(p.relative_to(install)): p.read_text() for p in install.rglob("package.dsv")}
+
+
 def ros_domain_id(base: int) -> str:
     """A ROS domain of its own for each pytest-xdist worker, so tests never see each other's nodes."""
     worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")

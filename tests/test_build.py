@@ -14,7 +14,8 @@ import psutil
 import pytest
 
 from build_helpers import (
-    BIN, colcon, copy_fixture, in_sourced_shell, installed_files, ros_env, roc, sourced_values,
+    BIN, colcon, comparable_install_files, copy_fixture, in_sourced_shell, package_dsv_files, ros_env, roc,
+    sourced_values,
 )
 
 pytestmark = pytest.mark.slow
@@ -76,11 +77,8 @@ def test_same_tree_and_environment_as_colcon(tmp_path):
     assert roc("work", "build", cwd=ours).returncode == 0
     result = colcon("build", cwd=theirs)
     assert result.returncode == 0, result.stdout + result.stderr
-    # Differences, justified: roc writes no PowerShell scripts yet, and needs no Python helper
-    # scripts at source time (colcon's _local_setup_util_*.py).
-    colcon_only = {f for f in installed_files(theirs / "install") - installed_files(ours / "install")}
-    assert all(f.endswith(".ps1") or "_local_setup_util_" in f for f in colcon_only), colcon_only
-    assert installed_files(ours / "install") - installed_files(theirs / "install") == set()
+    assert comparable_install_files(ours / "install") == comparable_install_files(theirs / "install")
+    assert package_dsv_files(ours / "install") == package_dsv_files(theirs / "install")
     ours_env = sourced_values(ours)
     theirs_env = sourced_values(theirs, strict=False)  # colcon's scripts are not `set -u` safe
     # colcon leaves an empty entry (the current directory) at the end of LD_LIBRARY_PATH; roc does not.

@@ -16,7 +16,8 @@ import pytest
 from catkin_pkg.package import parse_package
 
 from build_helpers import (
-    BIN, colcon, in_sourced_shell, installed_files, roc, ros_domain_id, ros_env, sourced_values, stop_process,
+    BIN, colcon, comparable_install_files, in_sourced_shell, installed_files, package_dsv_files, roc, ros_domain_id,
+    ros_env, sourced_values, stop_process,
 )
 
 MAINTAINER = ("--maintainer-name", "Ada Lovelace", "--maintainer-email", "ada@example.com")
@@ -220,11 +221,9 @@ def test_generated_packages_build_the_same_with_colcon(tmp_path):
         result = roc("work", "build", cwd=ws) if tool == "roc" else colcon("build", cwd=ws)
         assert result.returncode == 0, result.stdout + result.stderr
         trees[tool] = ws
-    ours, theirs = (installed_files(trees[tool] / "install") for tool in ("roc", "colcon"))
-
-    def comparable(files):  # roc writes no PowerShell scripts yet and needs no _local_setup_util_*.py
-        return {f for f in files if not f.endswith((".ps1", ".pyc")) and "_local_setup_util_" not in f}
-    assert comparable(ours) == comparable(theirs)
+    ours, theirs = (trees[tool] / "install" for tool in ("roc", "colcon"))
+    assert comparable_install_files(ours) == comparable_install_files(theirs)
+    assert package_dsv_files(ours) == package_dsv_files(theirs)
     ours_env = sourced_values(trees["roc"])
     theirs_env = sourced_values(trees["colcon"], strict=False)
     theirs_env["LD_LIBRARY_PATH"] = theirs_env["LD_LIBRARY_PATH"].rstrip(":")  # colcon's empty entry

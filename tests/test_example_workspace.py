@@ -9,7 +9,8 @@ import subprocess
 import pytest
 
 from build_helpers import (
-    BIN, REPO, colcon, in_sourced_shell, installed_files, roc, ros_domain_id, sourced_values, stop_process,
+    BIN, REPO, colcon, comparable_install_files, in_sourced_shell, package_dsv_files, roc, ros_domain_id,
+    sourced_values, stop_process,
 )
 
 pytestmark = pytest.mark.slow
@@ -60,12 +61,8 @@ def test_same_install_tree_and_environment_as_colcon(example, tmp_path):
     shutil.copytree(REPO / "workspaces" / "example" / "src", theirs / "src")
     result = colcon("build", "--parallel-workers", "2", cwd=theirs)
     assert result.returncode == 0, result.stdout + result.stderr
-    ours_files, theirs_files = installed_files(example / "install"), installed_files(theirs / "install")
-    # Justified differences: roc writes no PowerShell scripts yet and needs no _local_setup_util_*.py;
-    # byte-code caches depend on who imported what.
-    def comparable(files):
-        return {f for f in files if not f.endswith((".ps1", ".pyc")) and "_local_setup_util_" not in f}
-    assert comparable(ours_files) == comparable(theirs_files)
+    assert comparable_install_files(example / "install") == comparable_install_files(theirs / "install")
+    assert package_dsv_files(example / "install") == package_dsv_files(theirs / "install")
     ours_env = sourced_values(example)
     theirs_env = sourced_values(theirs, strict=False)
     theirs_env["LD_LIBRARY_PATH"] = theirs_env["LD_LIBRARY_PATH"].rstrip(":")  # colcon's empty entry

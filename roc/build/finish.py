@@ -2,7 +2,8 @@
 
 The hooks, in colcon's order: what the install prefix holds (CMake modules and configs, shared
 libraries, executables, pkg-config files, Python modules and scripts), then the hooks of the build type
-(ament_python: AMENT_PREFIX_PATH; ros.cmake: PKG_CONFIG_PATH), then those a colcon.pkg names.
+(ament_python: AMENT_PREFIX_PATH; ros.cmake: PKG_CONFIG_PATH; ament_cmake: the package's own
+local_setup scripts), then those a colcon.pkg names.
 """
 
 from __future__ import annotations
@@ -51,8 +52,7 @@ def finish_package(package: Package, prefix: Path) -> None:
     hooks: list[str] = []
 
     def hook(hook_name: str, line: str) -> None:
-        relative = write_hook(prefix, name, hook_name, line)
-        hooks.extend([f"{relative}.dsv", f"{relative}.sh"])
+        hooks.extend(write_hook(prefix, name, hook_name, line))
 
     module_dirs: list[Path] = []
     for directory in _cmake_module_paths(prefix, name):
@@ -81,6 +81,8 @@ def finish_package(package: Package, prefix: Path) -> None:
         hook("pkg_config_path", "prepend-non-duplicate;PKG_CONFIG_PATH;lib/pkgconfig")
         if multiarch():
             hook("pkg_config_path_multiarch", f"prepend-non-duplicate;PKG_CONFIG_PATH;lib/{multiarch()}/pkgconfig")
+    if package.type == "ros.ament_cmake":  # its own local_setup for every shell colcon knows, as colcon-ros lists them
+        hooks.extend(f"share/{name}/local_setup.{ext}" for ext in ("bash", "dsv", "ps1", "sh", "zsh"))
     hooks.extend(package.hooks)
     write_package_scripts(prefix, name, hooks)
     run_dependencies = sorted(package.dependencies.get("run", set()) - {name})

@@ -18,7 +18,7 @@ SET_TYPES = ("set", "set-if-unset")
 
 @dataclass(frozen=True)
 class Operation:
-    kind: str  # one of the types above, or "source" (a shell script without a .dsv twin)
+    kind: str  # one of the types above, or "source" (a script without a .dsv twin, for the shell of its suffix)
     name: str  # variable name, or the script path for "source"
     values: tuple[str, ...] = ()  # paths relative to the prefix (absolute ones stay absolute)
 
@@ -51,7 +51,7 @@ def resolve_operations(prefix: Path, dsv: Path) -> list[Operation]:
                 twin = target.with_suffix(".dsv")
                 if twin.is_file():
                     visit(twin)
-                elif target.suffix == ".sh":
+                else:
                     operations.append(Operation("source", first))
             else:
                 operations.append(Operation(kind, first, rest or ("",)))

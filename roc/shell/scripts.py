@@ -28,6 +28,8 @@ def _templates():
     environment.filters["shquote"] = lambda value: shlex.quote(str(value))
     # for values inside "...": keeps spaces and any characters, expands nothing
     environment.filters["dquote"] = lambda value: re.sub(r'([\\"$`])', r"\\\1", str(value))
+    # a PowerShell literal string: quote characters (PowerShell counts the typographic ones too) doubled
+    environment.filters["psquote"] = lambda value: "'" + re.sub("(['\u2018\u2019\u201a\u201b])", r"\1\1", str(value)) + "'"
     return environment
 
 
@@ -35,38 +37,47 @@ def render(template: str, **values) -> str:
     return _templates().get_template(template).render(**values)
 
 
-def write_hook(prefix: Path, package: str, name: str, line: str) -> str:
-    """Write ``share/<package>/hook/<name>.dsv`` (and its .sh twin); returns its path below ``prefix``."""
+def _package_script(shell: str, package: str, prefix: Path, operations: list[Operation], depth: int) -> str:
+    """A script applying ``operations`` in ``shell`` ("sh" or "ps1"), placed ``depth`` directories
+    below the prefix; of the ``source`` operations it runs only the scripts written for that shell."""
+    suffix = f".{shell}"
+    operations = [op for op in operations if op.kind != "source" or op.name.endswith(suffix)]
+    return render(f"package{suffix}.j2", package=package, prefix=prefix, operations=operations,
+                  up="/".join([".."] * depth))
+
+
+def write_hook(prefix: Path, package: str, name: str, line: str) -> list[str]:
+    """Write ``share/<package>/hook/<name>.dsv`` and its .ps1 and .sh twins; returns their paths below
+    ``prefix`` in the order colcon lists them in package.dsv."""
     relative = f"share/{package}/hook/{name}"
     write_text_atomic(prefix / f"{relative}.dsv", line + "\n")
     kind, variable, value = line.split(";", 2)
-    operation = Operation(kind, variable, (value,))
-    write_text_atomic(prefix / f"{relative}.sh", render("package.sh.j2", package=package, prefix=prefix,
-                                                          operations=[operation]))
-    return relative
+    operations = [Operation(kind, variable, (value,))]
+    for shell in ("ps1", "sh"):
+        write_text_atomic(prefix / f"{relative}.{shell}", _package_script(shell, package, prefix, operations, 3))
+    return [f"{relative}.{ext}" for ext in ("ps1", "dsv", "sh")]
 
 
 def write_package_scripts(prefix: Path, package: str, hooks: list[str]) -> None:
-    """``share/<package>/package.{dsv,sh,bash,zsh}``: the hooks (files below ``prefix``), then the
-    package's own local_setup."""
+    """``share/<package>/package.{dsv,sh,bash,zsh,ps1}`` applying ``hooks`` (files below ``prefix``)."""
     share = prefix / "share" / package
     lines = [f"source;{hook}" for hook in hooks]
-    lines += [f"source;share/{package}/local_setup.{ext}" for ext in ("bash", "dsv", "sh", "zsh")
-              if (share / f"local_setup.{ext}").exists()]
     write_text_atomic(share / "package.dsv", "".join(f"{line}\n" for line in lines))
     operations = resolve_operations(prefix, share / "package.dsv")
-    write_text_atomic(share / "package.sh", render("package.sh.j2", package=package, prefix=prefix,
-                                                   operations=operations))
+    for shell in ("ps1", "sh"):
+        write_text_atomic(share / f"package.{shell}", _package_script(shell, package, prefix, operations, 2))
     for shell in ("bash", "zsh"):
         write_text_atomic(share / f"package.{shell}", render("package.shell.j2", package=package, shell=shell))
 
 
 def write_install_scripts(base: Path, packages: list[str], merged: bool, underlays: list[str]) -> None:
     """Install-level ``local_setup.*`` (``packages`` in dependency order) and ``setup.*`` scripts."""
-    write_text_atomic(base / "local_setup.sh", render("local_setup.sh.j2", base=base, packages=packages,
-                                                      merged=merged))
+    for shell in ("sh", "ps1"):
+        write_text_atomic(base / f"local_setup.{shell}", render(f"local_setup.{shell}.j2", base=base,
+                                                                packages=packages, merged=merged))
     for shell in ("bash", "zsh"):
         write_text_atomic(base / f"local_setup.{shell}", render("local_setup.shell.j2", shell=shell))
     chain = [u for u in reversed(underlays) if Path(u) != base]
     for shell in SHELLS:
         write_text_atomic(base / f"setup.{shell}", render("setup.sh.j2", shell=shell, base=base, underlays=chain))
+    write_text_atomic(base / "setup.ps1", render("setup.ps1.j2", underlays=chain))
