@@ -28,9 +28,14 @@ def _templates():
     environment.filters["shquote"] = lambda value: shlex.quote(str(value))
     # for values inside "...": keeps spaces and any characters, expands nothing
     environment.filters["dquote"] = lambda value: re.sub(r'([\\"$`])', r"\\\1", str(value))
-    # a PowerShell literal string: quote characters (PowerShell counts the typographic ones too) doubled
-    environment.filters["psquote"] = lambda value: "'" + re.sub("(['\u2018\u2019\u201a\u201b])", r"\1\1", str(value)) + "'"
+    environment.filters["psquote"] = _powershell_literal
     return environment
+
+
+def _powershell_literal(value: object) -> str:
+    """A PowerShell '...' string: expands nothing; its quote characters (PowerShell counts the
+    typographic ones too) are doubled."""
+    return "'" + re.sub("(['\u2018\u2019\u201a\u201b])", r"\1\1", str(value)) + "'"
 
 
 def render(template: str, **values) -> str:
