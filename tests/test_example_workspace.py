@@ -12,6 +12,7 @@ from build_helpers import (
     BIN, REPO, colcon, comparable_install_files, in_sourced_shell, package_dsv_files, roc, ros_domain_id,
     sourced_values, stop_process,
 )
+from powershell_parse import check_package_scripts, parse
 
 pytestmark = pytest.mark.slow
 
@@ -32,6 +33,14 @@ def test_cpp_executables_and_interfaces(example):
                                     "print(Reading(value=2.5).value)'")
     assert ran.returncode == 0, ran.stderr
     assert ran.stdout.splitlines() == ["demo_tools: filtered 1 2 3 4 -> 2.5", "demo_plain: sum 1 2 3 4 -> 10", "2.5"]
+
+
+def test_powershell_scripts(example):
+    """The interface package's ament environment hooks (library path, Python path...) too."""
+    install = example / "install"
+    for script in install.rglob("*.ps1"):
+        parse(script.read_text())
+    check_package_scripts(install, ["demo_interfaces", "demo_core", "demo_tools", "demo_py", "demo_plain"], merged=False)
 
 
 def test_python_node_messages_arrive(example):
