@@ -69,15 +69,21 @@ class AppendToCommandLine(argparse._AppendAction):
         super().__call__(parser, namespace, values, option_string)
 
 
+def add_base_arguments(parser: argparse.ArgumentParser) -> None:
+    """Where the build directories and install prefixes are (build, cache, env)."""
+    parser.add_argument("--build-base", default="build", help="base directory of the build directories (default: build)")
+    parser.add_argument("--install-base", default="install",
+                        help="base directory of the install prefixes (default: install)")
+    parser.add_argument("--merge-install", action="store_true", help="install all packages into one prefix")
+
+
 def add_layout_arguments(parser: argparse.ArgumentParser) -> None:
     """The options that decide where packages go and what their fingerprints are (build and cache)."""
     add = parser.add_argument
     add("--metas", nargs="*", metavar="PATH",
         help="colcon metadata files, or directories holding a colcon.meta (default: ./colcon.meta)")
     add("--ignore-user-meta", action="store_true", help="ignore the *.meta files in ~/.colcon/metadata")
-    add("--build-base", default="build", help="base directory of the build directories (default: build)")
-    add("--install-base", default="install", help="base directory of the install prefixes (default: install)")
-    add("--merge-install", action="store_true", help="install all packages into one prefix")
+    add_base_arguments(parser)
     add("--symlink-install", action="store_true", help="symlink installed files to the sources where possible")
     add("--cmake-args", action=AppendToCommandLine, default=[], metavar="ARG",
         help="arguments for CMake (values may start with '-')")

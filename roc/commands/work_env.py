@@ -9,6 +9,7 @@ import shlex
 import sys
 
 from roc.cli.output import add_format_argument, print_json
+from roc.commands.work_build import add_base_arguments
 from roc.errors import UsageError
 from roc.workspace.selection import add_selection_arguments
 
@@ -17,9 +18,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("package", metavar="PKG_NAME", help="the package")
     parser.add_argument("command", nargs=argparse.REMAINDER, metavar="-- CMD",
                         help="run CMD in that environment instead of printing it")
-    parser.add_argument("--build-base", default="build", help="build base (default: build)")
-    parser.add_argument("--install-base", default="install", help="install base (default: install)")
-    parser.add_argument("--merge-install", action="store_true", help="the install base has the merged layout")
+    add_base_arguments(parser)
     add_format_argument(parser)
     add_selection_arguments(parser)
 

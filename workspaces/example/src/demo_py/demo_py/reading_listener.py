@@ -1,11 +1,10 @@
 """Log every reading received on /readings."""
 
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.task import Future
 
 from demo_interfaces.msg import Reading
+from demo_py.run import run_until_done
 
 
 class ReadingListener(Node):
@@ -27,15 +26,7 @@ class ReadingListener(Node):
 
 
 def main(args=None):
-    rclpy.init(args=args)
-    node = ReadingListener()
-    try:
-        rclpy.spin_until_future_complete(node, node.done)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    run_until_done(ReadingListener, args)
 
 
 if __name__ == '__main__':

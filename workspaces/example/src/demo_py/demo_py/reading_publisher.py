@@ -2,12 +2,11 @@
 
 import math
 
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.task import Future
 
 from demo_interfaces.msg import Reading
+from demo_py.run import run_until_done
 
 
 class ReadingPublisher(Node):
@@ -38,15 +37,7 @@ class ReadingPublisher(Node):
 
 
 def main(args=None):
-    rclpy.init(args=args)
-    node = ReadingPublisher()
-    try:
-        rclpy.spin_until_future_complete(node, node.done)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    run_until_done(ReadingPublisher, args)
 
 
 if __name__ == '__main__':
