@@ -123,7 +123,7 @@ PHASES = (
     ("      read_setup_cfg", "roc/workspace/python_setup.py", "read_setup_cfg"),
     ("  topological_order", "roc/workspace/graph.py", "topological_order"),
     ("  select_packages", "roc/workspace/selection.py", "select_packages"),
-    ("output: print_lines", "roc/cli/output.py", "print_lines"),
+    ("output: print_lines", "roc/render.py", "print_lines"),
     ("pathlib (all uses)", None, "pathlib"),
 )
 

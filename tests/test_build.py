@@ -12,9 +12,15 @@ from pathlib import Path
 
 import psutil
 import pytest
-
 from build_helpers import (
-    BIN, colcon, comparable_install_files, copy_fixture, in_sourced_shell, package_dsv_files, ros_env, roc,
+    BIN,
+    colcon,
+    comparable_install_files,
+    copy_fixture,
+    in_sourced_shell,
+    package_dsv_files,
+    roc,
+    ros_env,
     sourced_values,
 )
 

@@ -7,7 +7,6 @@ import shutil
 from pathlib import Path
 
 import pytest
-
 from build_helpers import BIN, roc, ros_env
 
 SHOW_MAKEFLAGS = """cmake_minimum_required(VERSION 3.8)

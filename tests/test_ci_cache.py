@@ -6,7 +6,6 @@ import json
 import shutil
 
 import pytest
-
 from build_helpers import FIXTURES, copy_fixture, in_sourced_shell, roc
 
 pytestmark = pytest.mark.slow

@@ -6,7 +6,11 @@ import importlib.util
 
 import pytest
 
-from roc.workspace.conditions import ConditionError, condition_environment, evaluate_condition
+from roc.workspace.conditions import (
+    ConditionError,
+    condition_environment,
+    evaluate_condition,
+)
 
 VARIABLES = {"ROS_VERSION": "2", "ROS_DISTRO": "jazzy", "ROS_PYTHON_VERSION": "3", "SPACED": "a b", "EMPTY": ""}
 

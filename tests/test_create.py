@@ -13,12 +13,20 @@ from pathlib import Path
 from xml.etree import ElementTree
 
 import pytest
-from catkin_pkg.package import parse_package
-
 from build_helpers import (
-    BIN, colcon, comparable_install_files, in_sourced_shell, installed_files, package_dsv_files, roc, ros_domain_id,
-    ros_env, sourced_values, stop_process,
+    BIN,
+    colcon,
+    comparable_install_files,
+    in_sourced_shell,
+    installed_files,
+    package_dsv_files,
+    roc,
+    ros_domain_id,
+    ros_env,
+    sourced_values,
+    stop_process,
 )
+from catkin_pkg.package import parse_package
 
 MAINTAINER = ("--maintainer-name", "Ada Lovelace", "--maintainer-email", "ada@example.com")
 OPTIONS = ("--build-type", "--dependencies", "--node-name", "--library-name", "--license", "--maintainer-name",

@@ -7,10 +7,17 @@ import shutil
 import subprocess
 
 import pytest
-
 from build_helpers import (
-    BIN, REPO, colcon, comparable_install_files, in_sourced_shell, package_dsv_files, roc, ros_domain_id,
-    sourced_values, stop_process,
+    BIN,
+    REPO,
+    colcon,
+    comparable_install_files,
+    in_sourced_shell,
+    package_dsv_files,
+    roc,
+    ros_domain_id,
+    sourced_values,
+    stop_process,
 )
 from powershell_parse import check_package_scripts, parse
 

@@ -9,8 +9,7 @@ import subprocess
 import time
 
 import pytest
-
-from build_helpers import BIN, copy_fixture, in_sourced_shell, ros_env, roc
+from build_helpers import BIN, copy_fixture, in_sourced_shell, roc, ros_env
 
 pytestmark = pytest.mark.slow
 

@@ -15,9 +15,13 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from fixture_workspaces import (
-    GOOD_FIXTURES, colcon_available, copy_fixture, normalize, run_colcon_batch, run_roc_inprocess,
+    GOOD_FIXTURES,
+    colcon_available,
+    copy_fixture,
+    normalize,
+    run_colcon_batch,
+    run_roc_inprocess,
     tool_environment,
 )
 

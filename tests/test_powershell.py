@@ -11,9 +11,9 @@ from __future__ import annotations
 import os
 
 import pytest
-
 from build_helpers import BIN, copy_fixture, in_sourced_shell, roc
 from powershell_parse import PARSER, applied, check_package_scripts, parse, statements
+
 from roc.environment.dsv import Operation
 from roc.shell.scripts import render
 

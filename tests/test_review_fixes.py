@@ -9,8 +9,7 @@ import subprocess
 import time
 
 import pytest
-
-from build_helpers import BIN, in_sourced_shell, ros_env, roc
+from build_helpers import BIN, in_sourced_shell, roc, ros_env
 
 
 def _plain(ws, name: str, text: str = "v1", depends: str = "") -> None:

@@ -11,8 +11,13 @@ import sys
 from pathlib import Path
 
 import pytest
+from fixture_workspaces import (
+    copy_fixture,
+    run_roc,
+    run_roc_inprocess,
+    tool_environment,
+)
 
-from fixture_workspaces import copy_fixture, run_roc, run_roc_inprocess, tool_environment
 from roc import __version__
 from roc.workspace.root import find_workspace_root, is_workspace_root
 

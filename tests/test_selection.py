@@ -9,10 +9,17 @@ from pathlib import Path
 import pytest
 
 from roc.errors import UsageError
-from roc.workspace.graph import DependencyCycleError, recursive_dependencies, topological_order
+from roc.workspace.dependencies import (
+    DependencyCycleError,
+    recursive_dependencies,
+    topological_order,
+)
 from roc.workspace.package import Package
 from roc.workspace.selection import (
-    add_selection_arguments, check_selection_arguments, ignore_packages, select_packages,
+    add_selection_arguments,
+    check_selection_arguments,
+    ignore_packages,
+    select_packages,
 )
 
 

@@ -7,7 +7,6 @@ import re
 from pathlib import Path
 
 import pytest
-
 from fixture_workspaces import copy_fixture, run_roc
 
 # fixture -> (file named in the message, what the message must also say)

@@ -116,7 +116,7 @@ def fish_script(tree: dict) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from roc.cli.main import build_parser
+    from roc.cli.commands import build_parser
 
     tree = command_tree(build_parser())
     script = {"bash": bash_script, "zsh": zsh_script, "fish": fish_script}[args.shell](tree)

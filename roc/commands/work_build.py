@@ -7,8 +7,8 @@ import os
 import sys
 from pathlib import Path
 
+from roc.cli.options import add_layout_arguments, add_selection_arguments
 from roc.errors import EXIT_FAILURE, EXIT_INTERRUPTED, UsageError
-from roc.workspace.selection import add_selection_arguments
 
 # colcon event handlers roc has, and the ones it accepts only when disabled.
 EVENT_HANDLERS = {"console_start_end", "console_stderr", "console_direct", "console_cohesion", "summary",
@@ -17,8 +17,6 @@ NOT_SUPPORTED_HANDLERS = {"compile_commands", "desktop_notification", "terminal_
                           "parallel_status"}
 NOT_SUPPORTED_OPTIONS = ("test_result_base", "catkin_cmake_args",
                          "catkin_skip_building_tests")
-# Options whose values are passed through to a tool and may themselves start with a dash.
-PASSTHROUGH_OPTIONS = ("--cmake-args", "--ament-cmake-args")
 DURATIONS_FILE = "roc_durations.json"
 
 
@@ -57,43 +55,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_selection_arguments(parser)
 
 
-class AppendToCommandLine(argparse._AppendAction):
-    """``append``, except that the first value given on the command line replaces a default list from
-    roc.toml or colcon's defaults instead of adding to it (the command line wins, as in colcon)."""
-
-    def __call__(self, parser, namespace, values, option_string=None):
-        marker = f"_given_{self.dest}"
-        if not getattr(namespace, marker, False):
-            setattr(namespace, self.dest, [])
-            setattr(namespace, marker, True)
-        super().__call__(parser, namespace, values, option_string)
-
-
-def add_base_arguments(parser: argparse.ArgumentParser) -> None:
-    """Where the build directories and install prefixes are (build, cache, env)."""
-    parser.add_argument("--build-base", default="build", help="base directory of the build directories (default: build)")
-    parser.add_argument("--install-base", default="install",
-                        help="base directory of the install prefixes (default: install)")
-    parser.add_argument("--merge-install", action="store_true", help="install all packages into one prefix")
-
-
-def add_layout_arguments(parser: argparse.ArgumentParser) -> None:
-    """The options that decide where packages go and what their fingerprints are (build and cache)."""
-    add = parser.add_argument
-    add("--metas", nargs="*", metavar="PATH",
-        help="colcon metadata files, or directories holding a colcon.meta (default: ./colcon.meta)")
-    add("--ignore-user-meta", action="store_true", help="ignore the *.meta files in ~/.colcon/metadata")
-    add_base_arguments(parser)
-    add("--symlink-install", action="store_true", help="symlink installed files to the sources where possible")
-    add("--cmake-args", action=AppendToCommandLine, default=[], metavar="ARG",
-        help="arguments for CMake (values may start with '-')")
-    add("--ament-cmake-args", action=AppendToCommandLine, default=[], metavar="ARG",
-        help="arguments for ament_cmake packages")
-
-
 def build_options(args: argparse.Namespace, root: Path, **extra):
     """BuildOptions from the command line and the configuration's per-package settings."""
-    from roc.handlers.context import BuildOptions
+    from roc.buildtypes.context import BuildOptions
 
     config = getattr(args, "configuration", None)
     per_package = {key: {name: tuple(value) for name, value in config.package_values(key).items()}
@@ -109,7 +73,7 @@ def build_options(args: argparse.Namespace, root: Path, **extra):
 
 def skip_unbuildable_packages(workspace) -> None:
     """Packages of a build type roc has no handler for are skipped with a warning, as colcon does."""
-    from roc.build.plan import HANDLERS
+    from roc.builder.plan import HANDLERS
     from roc.messages import warn
 
     for package in workspace.selected_in_order():
@@ -124,23 +88,6 @@ def skip_configured_packages(args: argparse.Namespace, workspace) -> None:
     config = getattr(args, "configuration", None)
     if config:
         workspace.selected -= {name for name, skip in config.package_values("skip").items() if skip}
-
-
-def rewrite_passthrough(argv: list[str], known_options: set[str]) -> list[str]:
-    """``--cmake-args -DA=1 -DB=2 --foo`` -> ``--cmake-args=-DA=1 --cmake-args=-DB=2 --foo``: values
-    run until the next roc option (a value that is also a roc option is written with a leading space)."""
-    result: list[str] = []
-    current = None
-    for token in argv:
-        if token in PASSTHROUGH_OPTIONS:
-            current = token
-            continue
-        if current and token.split("=", 1)[0] not in known_options:
-            result.append(f"{current}={token.lstrip(' ')}")
-            continue
-        current = None
-        result.append(token)
-    return result
 
 
 def _event_handler_switches(values: list[str]) -> dict[str, bool]:
@@ -165,7 +112,7 @@ def _check_supported(args: argparse.Namespace) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from roc.build.layout import prepare_build_base, prepare_install_base
+    from roc.builder.layout import prepare_build_base, prepare_install_base
     from roc.workspace.load import load_workspace
 
     _check_supported(args)
@@ -176,7 +123,7 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("--parallel-workers must be 0 (no limit) or more")
     if args.jobs is not None and args.jobs < 1:
         raise UsageError("-j/--jobs must be 1 or more")
-    from roc.build.lock import build_lock
+    from roc.builder.lock import build_lock
     from roc.engine.jobserver import jobs_from_makeflags
 
     workspace = load_workspace(args)
@@ -200,8 +147,13 @@ def run(args: argparse.Namespace) -> int:
 
 def _output_handlers(args, switches: dict[str, bool], root: Path, build_base: Path) -> list:
     """Where events go: logs, stored results, and the console (or JSON events)."""
-    from roc.output.console import ConsoleHandler
-    from roc.output.logs import JsonEventsHandler, LogHandler, ResultStore, new_log_directory
+    from roc.handlers.console import ConsoleHandler
+    from roc.handlers.logs import (
+        JsonEventsHandler,
+        LogHandler,
+        ResultStore,
+        new_log_directory,
+    )
 
     handlers: list = []
     log_dir = None
@@ -215,7 +167,7 @@ def _output_handlers(args, switches: dict[str, bool], root: Path, build_base: Pa
     else:
         status = None
         if switches.get("status", True) and sys.stdout.isatty() and not os.environ.get("NO_COLOR"):
-            from roc.output.status import StatusLine
+            from roc.handlers.status import StatusLine
 
             status = StatusLine()
         handlers.append(ConsoleHandler(
@@ -228,8 +180,8 @@ def _output_handlers(args, switches: dict[str, bool], root: Path, build_base: Pa
 
 
 def _build(args, workspace, options, switches: dict[str, bool]) -> int:
-    from roc.build.layout import refresh_install_scripts
-    from roc.build.plan import plan_build
+    from roc.builder.layout import refresh_install_scripts
+    from roc.builder.plan import plan_build
     from roc.engine.executor import execute
     from roc.engine.jobserver import Jobserver
     from roc.engine.store import DurationStore

@@ -13,8 +13,8 @@ import json
 import sys
 from pathlib import Path
 
-from roc.commands.work_build import add_layout_arguments, build_options
-from roc.workspace.selection import add_selection_arguments
+from roc.cli.options import add_layout_arguments, add_selection_arguments
+from roc.commands.work_build import build_options
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -25,8 +25,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from roc.build.cache_store import check_isolated, export_cache, import_cache
-    from roc.build.plan import fingerprint_packages
+    from roc.builder.cache_store import check_isolated, export_cache, import_cache
+    from roc.builder.plan import fingerprint_packages
     from roc.errors import UsageError
     from roc.workspace.load import load_workspace
 
@@ -46,9 +46,12 @@ def run(args: argparse.Namespace) -> int:
                               workspace.selected_in_order())
         print(f"exported {len(stored)} up-to-date package(s) to {cache}")
         return 0
-    from roc.build.layout import prepare_build_base, prepare_install_base, refresh_install_scripts
-
-    from roc.build.lock import build_lock
+    from roc.builder.layout import (
+        prepare_build_base,
+        prepare_install_base,
+        refresh_install_scripts,
+    )
+    from roc.builder.lock import build_lock
 
     with build_lock(options.build_base):  # never replace a prefix while a build uses it
         prepare_build_base(options.build_base)

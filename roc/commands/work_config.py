@@ -5,8 +5,9 @@ from __future__ import annotations
 import argparse
 import sys
 
-from roc.cli.output import add_format_argument, print_json
+from roc.cli.options import add_format_argument
 from roc.config import VERBS
+from roc.render import print_json
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -19,13 +20,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from roc.cli.main import build_parser
+    from roc.cli.commands import build_parser
     from roc.config import apply_configuration, load_configuration
     from roc.workspace.root import find_workspace_root
 
     root = find_workspace_root(Path.cwd()) or Path.cwd()
     config = load_configuration(root, args.verb, args.profile)
-    verb_parser = build_parser(["work", args.verb]).leaves[("work", args.verb)]  # type: ignore[attr-defined]
+    verb_parser = build_parser(["work", args.verb]).leaves[("work", args.verb)]
     applied = apply_configuration(verb_parser, config)
     rows = []
     for action in verb_parser._actions:

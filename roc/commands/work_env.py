@@ -8,10 +8,13 @@ import re
 import shlex
 import sys
 
-from roc.cli.output import add_format_argument, print_json
-from roc.commands.work_build import add_base_arguments
+from roc.cli.options import (
+    add_base_arguments,
+    add_format_argument,
+    add_selection_arguments,
+)
 from roc.errors import UsageError
-from roc.workspace.selection import add_selection_arguments
+from roc.render import print_json
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -24,9 +27,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from roc.build.plan import build_environment, saved_environment
-    from roc.handlers.context import BuildOptions
-    from roc.workspace.graph import recursive_dependencies
+    from roc.builder.plan import build_environment, saved_environment
+    from roc.buildtypes.context import BuildOptions
+    from roc.workspace.dependencies import recursive_dependencies
     from roc.workspace.load import find_workspace_root_for
 
     root = find_workspace_root_for(args)

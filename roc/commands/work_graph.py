@@ -6,11 +6,11 @@ import argparse
 import os
 from pathlib import Path
 
-from roc.cli.output import add_format_argument, print_json, print_lines
-from roc.workspace.graph import recursive_dependencies
+from roc.cli.options import add_format_argument, add_selection_arguments
+from roc.render import print_json, print_lines
+from roc.workspace.dependencies import recursive_dependencies
 from roc.workspace.load import Workspace
 from roc.workspace.package import CATEGORIES, Package
-from roc.workspace.selection import add_selection_arguments
 
 COLORS = {"build": "#0000ff", "run": "#ff0000", "test": "#d2b48c"}  # blue, red, tan
 LEGEND = (

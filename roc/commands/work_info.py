@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 import difflib
 
-from roc.cli.output import add_format_argument, print_json, print_lines
+from roc.cli.options import add_format_argument, add_selection_arguments
 from roc.errors import RocError, UsageError
+from roc.render import print_json, print_lines
 from roc.workspace.package import Package
-from roc.workspace.selection import add_selection_arguments
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

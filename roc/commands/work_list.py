@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from roc.cli.output import add_format_argument, print_json, print_lines
-from roc.workspace.selection import add_selection_arguments
+from roc.cli.options import add_format_argument, add_selection_arguments
+from roc.render import print_json, print_lines
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -10,16 +10,23 @@ import signal
 import threading
 import time
 import traceback
+from collections.abc import Callable, Iterable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
-from collections.abc import Callable, Iterable
 
 from roc.engine.events import (
-    Event, RunFinished, TaskAborted, TaskFailed, TaskFinished, TaskQueued, TaskSkipped,
-    TaskStarted, Tick,
+    Event,
+    RunFinished,
+    TaskAborted,
+    TaskFailed,
+    TaskFinished,
+    TaskQueued,
+    TaskSkipped,
+    TaskStarted,
+    Tick,
 )
-from roc.engine.graph import ReadyQueue, Task
 from roc.engine.process import TaskCancelled, TaskContext, TaskError
+from roc.engine.ready import ReadyQueue, Task
 
 Handler = Callable[[Event], None]
 TICK_SECONDS = 0.25

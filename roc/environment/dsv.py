@@ -7,9 +7,9 @@ operations into the generated shell scripts (no Python at source time).
 from __future__ import annotations
 
 import os
+from collections.abc import MutableMapping
 from dataclasses import dataclass
 from pathlib import Path
-from collections.abc import MutableMapping
 
 PREPEND_TYPES = ("prepend-non-duplicate", "prepend-non-duplicate-if-exists")
 APPEND_TYPES = ("append-non-duplicate",)

@@ -1,1 +1,1 @@
-"""Build-type handlers: how each kind of package (ament_cmake, cmake, ament_python, python) is built."""
+"""Event handlers: the console, log files, stored results and JSON events for CI."""

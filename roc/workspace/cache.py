@@ -11,8 +11,8 @@ from __future__ import annotations
 import json
 import os
 import zlib
-from pathlib import Path
 from collections.abc import Callable, Mapping
+from pathlib import Path
 
 from roc import __version__, messages
 from roc.fsutil import write_text_atomic

@@ -10,10 +10,10 @@ from __future__ import annotations
 import glob
 import os
 import re
-from pathlib import Path
 from collections.abc import Iterable, Mapping
+from pathlib import Path
 
-from roc.errors import UsageError, RocError
+from roc.errors import RocError, UsageError
 from roc.workspace.identify import SkipLocation, identify
 from roc.workspace.package import IGNORE_MARKERS, Package
 

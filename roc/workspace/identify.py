@@ -13,15 +13,20 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
 from collections.abc import Mapping
+from pathlib import Path
 
 from roc.errors import ManifestError
 from roc.messages import warn
 from roc.workspace.cmake_project import read_cmake_project
 from roc.workspace.manifest import parse_manifest
 from roc.workspace.package import CATEGORIES, Package
-from roc.workspace.python_setup import PythonProject, read_setup_cfg, read_setup_py, setup_cfg_is_sufficient
+from roc.workspace.python_setup import (
+    PythonProject,
+    read_setup_cfg,
+    read_setup_py,
+    setup_cfg_is_sufficient,
+)
 
 # Files of catkin devel/install spaces and ament_tools install spaces, which hold no markers.
 INSTALL_SPACE_FILES = ("_setup_util.py", "_order_isolated_packages.py")

@@ -7,12 +7,16 @@ import os
 import sys
 from pathlib import Path
 
-from roc.workspace.conditions import condition_environment
 from roc.workspace.cache import cached_discovery
-from roc.workspace.graph import topological_order
+from roc.workspace.conditions import condition_environment
+from roc.workspace.dependencies import topological_order
 from roc.workspace.package import Package
 from roc.workspace.root import find_workspace_root
-from roc.workspace.selection import check_selection_arguments, ignore_packages, select_packages
+from roc.workspace.selection import (
+    check_selection_arguments,
+    ignore_packages,
+    select_packages,
+)
 
 
 class Workspace:

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import re
 from collections import namedtuple
-from pathlib import Path
 from collections.abc import Mapping
+from pathlib import Path
 
 from roc.errors import ManifestError
 from roc.workspace.conditions import ConditionError, evaluate_condition
@@ -92,7 +92,9 @@ class Manifest:
 
 def parse_manifest(path: Path, variables: Mapping[str, str]) -> Manifest:
     """Parse ``path`` (a package.xml), evaluating conditions against ``variables``."""
-    from lxml import etree  # imported here: 20 ms that commands without manifests should not pay
+    from lxml import (
+        etree,  # imported here: 20 ms that commands without manifests should not pay
+    )
 
     try:
         root = etree.parse(str(path), etree.XMLParser(remove_comments=True)).getroot()

@@ -9,12 +9,12 @@ from __future__ import annotations
 import argparse
 import difflib
 import re
-from pathlib import Path
 from collections.abc import Callable, Iterable
+from pathlib import Path
 
 from roc.errors import UsageError
-from roc.workspace.graph import recursive_dependencies
 from roc.messages import warn
+from roc.workspace.dependencies import recursive_dependencies
 from roc.workspace.package import Package
 
 # Options that take package names, checked against the workspace.
@@ -24,46 +24,6 @@ NAME_OPTIONS = (
 )
 REGEX_OPTIONS = ("packages_ignore_regex", "packages_up_to_regex", "packages_select_regex", "packages_skip_regex")
 INTERRUPTED_RESULT = "SIGINT"
-
-
-def add_selection_arguments(parser: argparse.ArgumentParser) -> None:
-    """Discovery and selection options, as in colcon (``--packages-start``/``-end`` spelled as colcon 0.21)."""
-    discovery = parser.add_argument_group("discovery")
-    discovery.add_argument("--base-paths", nargs="*", metavar="PATH",
-                           help="base paths to crawl recursively for packages (default: the workspace root)")
-    discovery.add_argument("--paths", nargs="*", metavar="PATH",
-                           help="package directories to use (shell wildcards allowed, e.g. 'src/*')")
-    discovery.add_argument("--packages-ignore", nargs="*", metavar="PKG_NAME",
-                           help="ignore packages as if they were not discovered")
-    discovery.add_argument("--packages-ignore-regex", nargs="*", metavar="PATTERN",
-                           help="ignore packages whose name matches any of the patterns")
-    group = parser.add_argument_group("package selection")
-    add = group.add_argument
-    add("--packages-up-to", nargs="*", metavar="PKG_NAME", help="only these packages and their recursive dependencies")
-    add("--packages-up-to-regex", nargs="*", metavar="PATTERN",
-        help="only packages matching a pattern and their recursive dependencies")
-    add("--packages-above", nargs="*", metavar="PKG_NAME",
-        help="only these packages and the packages that recursively depend on them")
-    add("--packages-above-and-dependencies", nargs="*", metavar="PKG_NAME",
-        help="as --packages-above, plus the recursive dependencies of all of those")
-    add("--packages-above-depth", nargs="+", metavar=("DEPTH", "PKG_NAME"),
-        help="as --packages-above, but only up to DEPTH levels of dependents")
-    add("--packages-select-by-dep", nargs="*", metavar="DEP_NAME",
-        help="only packages that (recursively) depend on any of these")
-    add("--packages-skip-by-dep", nargs="*", metavar="DEP_NAME",
-        help="skip packages that (recursively) depend on any of these")
-    add("--packages-skip-up-to", nargs="*", metavar="PKG_NAME", help="skip these packages and their recursive dependencies")
-    previous = group.add_mutually_exclusive_group()
-    previous.add_argument("--packages-select-build-failed", action="store_true",
-                          help="only packages whose last build failed (aborted ones are not failures)")
-    previous.add_argument("--packages-skip-build-finished", action="store_true",
-                          help="skip packages whose last build finished successfully")
-    add("--packages-select", nargs="*", metavar="PKG_NAME", help="only these packages")
-    add("--packages-skip", nargs="*", metavar="PKG_NAME", help="skip these packages")
-    add("--packages-select-regex", nargs="*", metavar="PATTERN", help="only packages whose name matches a pattern")
-    add("--packages-skip-regex", nargs="*", metavar="PATTERN", help="skip packages whose name matches a pattern")
-    add("--packages-start", metavar="PKG_NAME", help="skip packages before this one in topological order")
-    add("--packages-end", metavar="PKG_NAME", help="skip packages after this one in topological order")
 
 
 def _matches(patterns: Iterable[str] | None, name: str) -> bool:

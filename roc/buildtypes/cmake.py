@@ -10,9 +10,9 @@ import re
 import shutil
 from pathlib import Path
 
+from roc.buildtypes.context import BuildOptions, PackageJob
 from roc.engine.process import TaskContext, TaskError
 from roc.fsutil import write_text_atomic
-from roc.handlers.context import BuildOptions, PackageJob
 
 
 def cmake_arguments(job: PackageJob, options: BuildOptions) -> list[str]:

@@ -7,7 +7,14 @@ import time
 from typing import TextIO
 
 from roc.engine.events import (
-    Event, RunFinished, TaskAborted, TaskFailed, TaskFinished, TaskOutput, TaskSkipped, TaskStarted,
+    Event,
+    RunFinished,
+    TaskAborted,
+    TaskFailed,
+    TaskFinished,
+    TaskOutput,
+    TaskSkipped,
+    TaskStarted,
 )
 
 

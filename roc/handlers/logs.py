@@ -11,7 +11,15 @@ from dataclasses import asdict
 from pathlib import Path
 
 from roc.engine.events import (
-    CommandEnded, CommandStarted, Event, RunFinished, TaskAborted, TaskFailed, TaskFinished, TaskOutput, Tick,
+    CommandEnded,
+    CommandStarted,
+    Event,
+    RunFinished,
+    TaskAborted,
+    TaskFailed,
+    TaskFinished,
+    TaskOutput,
+    Tick,
 )
 from roc.fsutil import write_text_atomic
 from roc.workspace.selection import INTERRUPTED_RESULT

@@ -5,22 +5,28 @@ from __future__ import annotations
 import json
 import os
 import sys
-from pathlib import Path
 from collections.abc import Callable
+from pathlib import Path
 
-from roc.build.finish import finish_package
-from roc.build.fingerprint import combine, external_stamp, source_digest, toolchain_digest, underlay_prefixes
-from roc.build.state import install_intact, read_state, write_state
-from roc.build.layout import package_prefix
-from roc.engine.graph import Task
+from roc.builder.fingerprint import (
+    combine,
+    external_stamp,
+    source_digest,
+    toolchain_digest,
+    underlay_prefixes,
+)
+from roc.builder.finish import finish_package
+from roc.builder.layout import package_prefix
+from roc.builder.state import install_intact, read_state, write_state
+from roc.buildtypes.cmake import build_cmake
+from roc.buildtypes.context import BuildOptions, PackageJob
+from roc.buildtypes.python import build_python
 from roc.engine.jobserver import Jobserver
 from roc.engine.process import TaskContext
+from roc.engine.ready import Task
 from roc.environment.dsv import apply_operations, resolve_operations
 from roc.fsutil import write_text_atomic
-from roc.handlers.cmake import build_cmake
-from roc.handlers.context import BuildOptions, PackageJob
-from roc.handlers.python import build_python
-from roc.workspace.graph import recursive_dependencies
+from roc.workspace.dependencies import recursive_dependencies
 from roc.workspace.load import Workspace
 from roc.workspace.package import Package
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from roc.errors import RocError, UsageError
 from roc.fsutil import write_text_atomic
-from roc.workspace.graph import layered_order
+from roc.workspace.dependencies import layered_order
 
 LAYOUT_MARKER = ".colcon_install_layout"
 BUILT_BY_MARKER = ".built_by"

@@ -20,8 +20,8 @@ import tempfile
 from pathlib import Path
 
 from roc import __version__
-from roc.build.finish import finish_package
-from roc.build.state import STATE_FILE, install_intact, read_state
+from roc.builder.finish import finish_package
+from roc.builder.state import STATE_FILE, install_intact, read_state
 from roc.errors import RocError, UsageError
 from roc.fsutil import file_sha256, write_text_atomic
 from roc.messages import warn

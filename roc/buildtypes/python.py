@@ -15,8 +15,8 @@ import sys
 import sysconfig
 from pathlib import Path
 
+from roc.buildtypes.context import BuildOptions, PackageJob
 from roc.engine.process import TaskContext, TaskError
-from roc.handlers.context import BuildOptions, PackageJob
 
 
 def python_lib(prefix: Path) -> Path:

@@ -8,8 +8,8 @@ direct ones), so the stdlib's ``graphlib`` does it without the cost of importing
 
 from __future__ import annotations
 
-from graphlib import CycleError, TopologicalSorter
 from collections.abc import Iterable
+from graphlib import CycleError, TopologicalSorter
 
 from roc.errors import RocError
 from roc.workspace.package import CATEGORIES, Package

@@ -13,8 +13,8 @@ import subprocess
 from functools import lru_cache
 from pathlib import Path
 
+from roc.buildtypes.python import python_lib
 from roc.fsutil import write_text_atomic
-from roc.handlers.python import python_lib
 from roc.shell.scripts import write_hook, write_package_scripts
 from roc.workspace.package import Package
 

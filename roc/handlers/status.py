@@ -9,7 +9,15 @@ import re
 import time
 
 from roc.engine.events import (
-    Event, RunFinished, TaskAborted, TaskFailed, TaskFinished, TaskOutput, TaskQueued, TaskSkipped, TaskStarted,
+    Event,
+    RunFinished,
+    TaskAborted,
+    TaskFailed,
+    TaskFinished,
+    TaskOutput,
+    TaskQueued,
+    TaskSkipped,
+    TaskStarted,
 )
 
 _MAKE_PROGRESS = re.compile(rb"\[\s*(\d{1,3})%\]")

@@ -1,0 +1,106 @@
+"""Option groups shared by several verbs, defined once: discovery and selection, where packages are
+built and installed, and the output format."""
+
+from __future__ import annotations
+
+import argparse
+
+# Options whose values are passed through to a tool and may themselves start with a dash.
+PASSTHROUGH_OPTIONS = ("--cmake-args", "--ament-cmake-args")
+
+
+def add_format_argument(parser: argparse.ArgumentParser, formats: tuple[str, ...] = ("text", "json")) -> None:
+    parser.add_argument("--format", choices=formats, default="text",
+                        help="output format (default: text); json is stable for scripts")
+
+
+def add_selection_arguments(parser: argparse.ArgumentParser) -> None:
+    """Discovery and selection options, as in colcon (``--packages-start``/``-end`` spelled as colcon 0.21)."""
+    discovery = parser.add_argument_group("discovery")
+    discovery.add_argument("--base-paths", nargs="*", metavar="PATH",
+                           help="base paths to crawl recursively for packages (default: the workspace root)")
+    discovery.add_argument("--paths", nargs="*", metavar="PATH",
+                           help="package directories to use (shell wildcards allowed, e.g. 'src/*')")
+    discovery.add_argument("--packages-ignore", nargs="*", metavar="PKG_NAME",
+                           help="ignore packages as if they were not discovered")
+    discovery.add_argument("--packages-ignore-regex", nargs="*", metavar="PATTERN",
+                           help="ignore packages whose name matches any of the patterns")
+    group = parser.add_argument_group("package selection")
+    add = group.add_argument
+    add("--packages-up-to", nargs="*", metavar="PKG_NAME", help="only these packages and their recursive dependencies")
+    add("--packages-up-to-regex", nargs="*", metavar="PATTERN",
+        help="only packages matching a pattern and their recursive dependencies")
+    add("--packages-above", nargs="*", metavar="PKG_NAME",
+        help="only these packages and the packages that recursively depend on them")
+    add("--packages-above-and-dependencies", nargs="*", metavar="PKG_NAME",
+        help="as --packages-above, plus the recursive dependencies of all of those")
+    add("--packages-above-depth", nargs="+", metavar=("DEPTH", "PKG_NAME"),
+        help="as --packages-above, but only up to DEPTH levels of dependents")
+    add("--packages-select-by-dep", nargs="*", metavar="DEP_NAME",
+        help="only packages that (recursively) depend on any of these")
+    add("--packages-skip-by-dep", nargs="*", metavar="DEP_NAME",
+        help="skip packages that (recursively) depend on any of these")
+    add("--packages-skip-up-to", nargs="*", metavar="PKG_NAME", help="skip these packages and their recursive dependencies")
+    previous = group.add_mutually_exclusive_group()
+    previous.add_argument("--packages-select-build-failed", action="store_true",
+                          help="only packages whose last build failed (aborted ones are not failures)")
+    previous.add_argument("--packages-skip-build-finished", action="store_true",
+                          help="skip packages whose last build finished successfully")
+    add("--packages-select", nargs="*", metavar="PKG_NAME", help="only these packages")
+    add("--packages-skip", nargs="*", metavar="PKG_NAME", help="skip these packages")
+    add("--packages-select-regex", nargs="*", metavar="PATTERN", help="only packages whose name matches a pattern")
+    add("--packages-skip-regex", nargs="*", metavar="PATTERN", help="skip packages whose name matches a pattern")
+    add("--packages-start", metavar="PKG_NAME", help="skip packages before this one in topological order")
+    add("--packages-end", metavar="PKG_NAME", help="skip packages after this one in topological order")
+
+
+
+class AppendToCommandLine(argparse._AppendAction):
+    """``append``, except that the first value given on the command line replaces a default list from
+    roc.toml or colcon's defaults instead of adding to it (the command line wins, as in colcon)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        marker = f"_given_{self.dest}"
+        if not getattr(namespace, marker, False):
+            setattr(namespace, self.dest, [])
+            setattr(namespace, marker, True)
+        super().__call__(parser, namespace, values, option_string)
+
+
+def add_base_arguments(parser: argparse.ArgumentParser) -> None:
+    """Where the build directories and install prefixes are (build, cache, env)."""
+    parser.add_argument("--build-base", default="build", help="base directory of the build directories (default: build)")
+    parser.add_argument("--install-base", default="install",
+                        help="base directory of the install prefixes (default: install)")
+    parser.add_argument("--merge-install", action="store_true", help="install all packages into one prefix")
+
+
+def add_layout_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options that decide where packages go and what their fingerprints are (build and cache)."""
+    add = parser.add_argument
+    add("--metas", nargs="*", metavar="PATH",
+        help="colcon metadata files, or directories holding a colcon.meta (default: ./colcon.meta)")
+    add("--ignore-user-meta", action="store_true", help="ignore the *.meta files in ~/.colcon/metadata")
+    add_base_arguments(parser)
+    add("--symlink-install", action="store_true", help="symlink installed files to the sources where possible")
+    add("--cmake-args", action=AppendToCommandLine, default=[], metavar="ARG",
+        help="arguments for CMake (values may start with '-')")
+    add("--ament-cmake-args", action=AppendToCommandLine, default=[], metavar="ARG",
+        help="arguments for ament_cmake packages")
+
+
+def rewrite_passthrough(argv: list[str], known_options: set[str]) -> list[str]:
+    """``--cmake-args -DA=1 -DB=2 --foo`` -> ``--cmake-args=-DA=1 --cmake-args=-DB=2 --foo``: values
+    run until the next roc option (a value that is also a roc option is written with a leading space)."""
+    result: list[str] = []
+    current = None
+    for token in argv:
+        if token in PASSTHROUGH_OPTIONS:
+            current = token
+            continue
+        if current and token.split("=", 1)[0] not in known_options:
+            result.append(f"{current}={token.lstrip(' ')}")
+            continue
+        current = None
+        result.append(token)
+    return result

@@ -1,1 +1,0 @@
-"""Event handlers: the console, log files, stored results and JSON events for CI."""

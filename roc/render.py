@@ -1,0 +1,66 @@
+"""Everything a verb prints to stdout goes through here: lines of text, aligned tables, JSON and YAML.
+
+Verbs build plain data (lists, dicts) and pick a renderer by ``--format``; nothing else writes
+``json.dumps``/``yaml.dump`` output or pads columns by hand, so every verb's formats look alike.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections.abc import Iterable, Sequence
+from typing import Any, TextIO
+
+
+def print_lines(lines: Iterable[str], stream: TextIO | None = None) -> None:
+    (stream or sys.stdout).write("".join(f"{line}\n" for line in lines))
+
+
+def print_json(data: Any, stream: TextIO | None = None) -> None:
+    """One JSON document, indented (for listings)."""
+    out = stream or sys.stdout
+    json.dump(data, out, indent=2, sort_keys=False)
+    out.write("\n")
+
+
+def print_json_line(data: Any, stream: TextIO | None = None) -> None:
+    """One compact JSON object on one line, flushed (for streams: events, messages, status)."""
+    out = stream or sys.stdout
+    out.write(json.dumps(data, separators=(",", ":")) + "\n")
+    out.flush()
+
+
+def to_yaml(data: Any, flow_style: bool | None = False) -> str:
+    """YAML with keys in their given order, as ros2 prints messages and parameters."""
+    import yaml
+
+    return yaml.dump(data, sort_keys=False, default_flow_style=flow_style, allow_unicode=True)
+
+
+def print_yaml(data: Any, stream: TextIO | None = None) -> None:
+    (stream or sys.stdout).write(to_yaml(data))
+
+
+def table_lines(rows: Sequence[Sequence[Any]], header: Sequence[str] | None = None, gap: str = "  ") -> list[str]:
+    """Rows as left-aligned columns (the last column is not padded)."""
+    all_rows = [list(map(str, header))] if header else []
+    all_rows += [[str(cell) for cell in row] for row in rows]
+    if not all_rows:
+        return []
+    widths = [max(len(row[i]) for row in all_rows if i < len(row)) for i in range(max(map(len, all_rows)))]
+    return [gap.join(cell.ljust(widths[i]) if i < len(row) - 1 else cell for i, cell in enumerate(row)).rstrip()
+            for row in all_rows]
+
+
+def print_table(rows: Sequence[Sequence[Any]], header: Sequence[str] | None = None, gap: str = "  ") -> None:
+    print_lines(table_lines(rows, header, gap))
+
+
+def render(data: Any, output_format: str, text: Iterable[str] | None = None) -> None:
+    """Print ``data`` as ``json`` or ``yaml``; as ``text``, the given lines."""
+    if output_format == "json":
+        print_json(data)
+    elif output_format == "yaml":
+        print_yaml(data)
+    else:
+        print_lines(text if text is not None else [str(data)])
