@@ -15,8 +15,8 @@ from roc.workspace.dependencies import (
     topological_order,
 )
 from roc.workspace.package import Package
+from roc.cli.options import add_selection_arguments
 from roc.workspace.selection import (
-    add_selection_arguments,
     check_selection_arguments,
     ignore_packages,
     select_packages,

@@ -2,12 +2,16 @@
 
 A fingerprint covers the package's source tree (hashed file by file; a file whose size and mtime are
 unchanged keeps its previous hash, so a no-op check only stats files), the options that shape its
-build, the toolchain and underlays, and the fingerprints of its workspace dependencies, so that a
-change propagates to every package that depends on it.
+build, the tools its build type runs and the underlays, and the fingerprints of its workspace
+dependencies, so that a change propagates to every package that depends on it.
+
+The parts are kept with the fingerprint of the last successful build, so that ``changes`` can say why
+a package is not up to date.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
@@ -24,14 +28,15 @@ from roc.workspace.package import IGNORE_MARKERS
 TOOLCHAIN_VARIABLES = ("CC", "CXX", "CFLAGS", "CXXFLAGS", "CPPFLAGS", "LDFLAGS", "CMAKE_GENERATOR",
                        "CMAKE_BUILD_TYPE", "ROS_DISTRO", "ROS_VERSION", "ROS_PYTHON_VERSION")
 PREFIX_VARIABLES = ("AMENT_PREFIX_PATH", "CMAKE_PREFIX_PATH", "COLCON_PREFIX_PATH")
-TOOLS = ("cmake", "make", "ninja", "cc", "c++", "gcc", "g++")
+# Files an editor, a file manager or a merge tool leaves next to sources; no build reads them.
+EDITOR_DROPPINGS = re.compile(r"^(\..*\.sw[a-p]|.*~|\.#.*|#.*#|\.DS_Store|4913)$")
 
-FileStamps = dict[str, list]  # relative path -> [size, mtime_ns, sha256]
+FileStamps = dict[str, list]  # relative path -> [size, mtime_ns, sha256, executable]
 
 
-def source_digest(directory: Path, previous: FileStamps) -> tuple[str, FileStamps]:
-    """Digest of the package's files (hidden and ignored directories skipped; symlinks followed, each
-    real directory once) and the new stamps."""
+def source_stamps(directory: Path, previous: FileStamps) -> FileStamps:
+    """The stamps of the package's files (hidden and ignored directories and editor droppings skipped;
+    symlinks followed, each real directory once)."""
     stamps: FileStamps = {}
     seen: set[str] = set()
     for dirpath, dirnames, filenames in os.walk(directory, followlinks=True):
@@ -42,7 +47,7 @@ def source_digest(directory: Path, previous: FileStamps) -> tuple[str, FileStamp
         seen.add(real)
         dirnames[:] = [d for d in dirnames if not d.startswith(".") and d != "__pycache__"]
         for name in filenames:
-            if name.endswith(".pyc"):
+            if name.endswith(".pyc") or EDITOR_DROPPINGS.match(name):
                 continue
             path = Path(dirpath, name)
             relative = os.path.relpath(path, directory)
@@ -57,11 +62,12 @@ def source_digest(directory: Path, previous: FileStamps) -> tuple[str, FileStamp
             else:
                 content = file_sha256(path)
             stamps[relative] = [info.st_size, info.st_mtime_ns, content, bool(info.st_mode & 0o100)]
-    digest = hashlib.sha256()
-    for relative in sorted(stamps):
-        _, _, content, executable = stamps[relative]
-        digest.update(f"{relative}\0{content}\0{int(executable)}\n".encode())
-    return digest.hexdigest(), stamps
+    return stamps
+
+
+def source_parts(stamps: FileStamps) -> dict[str, str]:
+    """What counts of each file: its content and whether it is executable."""
+    return {relative: f"{stamp[2]}:{int(stamp[3])}" for relative, stamp in sorted(stamps.items())}
 
 
 # Files colcon and roc write again on every build of a package, whatever changed.
@@ -114,8 +120,9 @@ def underlay_prefixes(env: dict[str, str], install_base: Path) -> list[str]:
     return found
 
 
-def _tool_identity(name: str) -> str | None:
-    found = shutil.which(name)
+@functools.cache
+def _tool_identity(name: str, path: str | None) -> str | None:
+    found = shutil.which(name, path=path)
     if not found:
         return None
     real = os.path.realpath(found)
@@ -123,22 +130,59 @@ def _tool_identity(name: str) -> str | None:
     return f"{real}:{info.st_size}:{info.st_mtime_ns}"
 
 
-def toolchain_digest(env: dict[str, str], install_base: Path) -> str:
-    """Compilers, build tools, Python and underlays (entries inside our own install base left out,
-    so building with the workspace itself sourced changes nothing)."""
+def build_tools(build_type: str, env: dict[str, str], cmake_args: tuple[str, ...]) -> tuple[str, ...]:
+    """The programs a package's build runs: for CMake, cmake, the generator's build tool and the
+    compilers (CC/CXX when set); for Python, only the interpreter (counted apart)."""
+    if build_type not in ("cmake", "ament_cmake"):
+        return ()
+    generator = env.get("CMAKE_GENERATOR", "")
+    for index, arg in enumerate(cmake_args):
+        if arg == "-G" and index + 1 < len(cmake_args):
+            generator = cmake_args[index + 1]
+        elif arg.startswith("-G"):
+            generator = arg[2:]
+    build_tool = "ninja" if "ninja" in generator.lower() else "make"
+    return ("cmake", build_tool, env.get("CC") or "cc", env.get("CXX") or "c++")
+
+
+def toolchain_parts(env: dict[str, str], install_base: Path, tools: tuple[str, ...]) -> dict[str, object]:
+    """Build variables, the given tools (as found on the build's PATH), Python and underlays (entries
+    inside our own install base left out, so building with the workspace itself sourced changes
+    nothing)."""
     own = str(install_base)
-    prefixes = {
-        name: [p for p in env.get(name, "").split(os.pathsep) if p and not p.startswith(own)]
-        for name in PREFIX_VARIABLES
-    }
-    data = {
-        "variables": {name: env.get(name) for name in TOOLCHAIN_VARIABLES},
-        "prefixes": prefixes,
-        "tools": {name: _tool_identity(name) for name in TOOLS},
-        "python": [sys.executable, sys.version],
-    }
-    return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()
+    parts: dict[str, object] = {f"variable {name}": env.get(name) for name in TOOLCHAIN_VARIABLES}
+    for name in PREFIX_VARIABLES:
+        parts[f"prefix path {name}"] = [p for p in env.get(name, "").split(os.pathsep) if p and not p.startswith(own)]
+    for tool in tools:
+        parts[f"tool {tool}"] = _tool_identity(tool, env.get("PATH"))
+    parts["python"] = [os.path.realpath(sys.executable), sys.version]
+    return parts
 
 
 def combine(parts: dict) -> str:
     return hashlib.sha256(json.dumps(parts, sort_keys=True).encode()).hexdigest()
+
+
+def _names(names: list[str], limit: int = 3) -> str:
+    shown = ", ".join(names[:limit])
+    return shown + (f" and {len(names) - limit} more" if len(names) > limit else "")
+
+
+def changes(before: dict, now: dict) -> list[str]:
+    """Why ``now``'s parts differ from ``before``'s, one short reason per kind of change."""
+    reasons = []
+    old_files, new_files = before.get("sources", {}), now.get("sources", {})
+    for label, names in (
+        ("files added", [f for f in new_files if f not in old_files]),
+        ("files changed", [f for f in new_files if f in old_files and old_files[f] != new_files[f]]),
+        ("files removed", [f for f in old_files if f not in new_files]),
+    ):
+        if names:
+            reasons.append(f"{label}: {_names(sorted(names))}")
+    for part, label in (("options", "option changed"), ("toolchain", "toolchain changed"),
+                        ("dependencies", "dependency changed"), ("underlay", "underlay package changed")):
+        old, new = before.get(part, {}), now.get(part, {})
+        names = sorted(k for k in old.keys() | new.keys() if old.get(k) != new.get(k))
+        if names:
+            reasons.append(f"{label}: {_names(names)}")
+    return reasons

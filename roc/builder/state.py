@@ -1,5 +1,6 @@
 """Per-package build state in ``<build-base>/<pkg>/roc_state.json``: the fingerprint of the last
-successful build and the file stamps that make the next check cheap. Written atomically; a damaged
+successful build and its parts (to say what changed since), and the file stamps that make the next
+check cheap. Written atomically; a damaged
 file is reported and ignored (the package is rebuilt), never trusted."""
 
 from __future__ import annotations
@@ -28,9 +29,9 @@ def read_state(build_dir: Path) -> dict:
     return state
 
 
-def write_state(build_dir: Path, fingerprint: str | None, files: dict) -> None:
-    """Record ``fingerprint`` as built (None: not up to date, e.g. before a build starts)."""
-    state = {"fingerprint": fingerprint, "files": files}
+def write_state(build_dir: Path, fingerprint: str | None, files: dict, parts: dict | None = None) -> None:
+    """Record ``fingerprint`` (made of ``parts``) as built; None: not up to date (a build started)."""
+    state = {"fingerprint": fingerprint, "files": files, "parts": parts}
     write_text_atomic(build_dir / STATE_FILE, json.dumps(state, separators=(",", ":")))
 
 

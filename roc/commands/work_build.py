@@ -73,13 +73,13 @@ def build_options(args: argparse.Namespace, root: Path, **extra):
 
 def skip_unbuildable_packages(workspace) -> None:
     """Packages of a build type roc has no handler for are skipped with a warning, as colcon does."""
-    from roc.builder.plan import HANDLERS
+    from roc.buildtypes import BUILD_TYPES
     from roc.messages import warn
 
     for package in workspace.selected_in_order():
-        if package.type not in HANDLERS:
+        if package.type not in BUILD_TYPES:
             warn(f"{package.path}: no way to build '{package.name}' of type '{package.type}' "
-                 f"(roc builds {', '.join(sorted(HANDLERS))}); skipped")
+                 f"(roc builds {', '.join(sorted(BUILD_TYPES))}); skipped")
             workspace.selected.discard(package.name)
 
 

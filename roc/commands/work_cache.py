@@ -26,7 +26,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from roc.builder.cache_store import check_isolated, export_cache, import_cache
-    from roc.builder.plan import fingerprint_packages
+    from roc.builder.uptodate import fingerprint_packages
     from roc.errors import UsageError
     from roc.workspace.load import load_workspace
 

@@ -27,7 +27,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from roc.builder.plan import build_environment, saved_environment
+    from roc.builder.environment import build_environment, saved_environment
     from roc.buildtypes.context import BuildOptions
     from roc.workspace.dependencies import recursive_dependencies
     from roc.workspace.load import find_workspace_root_for

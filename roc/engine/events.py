@@ -1,4 +1,8 @@
-"""Events emitted while tasks run. Workers never print; handlers turn events into output and logs."""
+"""Events emitted while tasks run. Workers never print; handlers turn events into output and logs.
+
+Every task event names its task by ``kind`` (``build``, ``idl``, ``test``, ``probe``, ...) and ``task``
+(what it works on: a package, a probe); ``key`` joins them, as the engine does.
+"""
 
 from __future__ import annotations
 
@@ -9,7 +13,17 @@ from dataclasses import dataclass, field
 @dataclass(frozen=True)
 class Event:
     task: str
+    kind: str = "build"
     time: float = field(default_factory=time.time, compare=False)
+
+    @property
+    def key(self) -> str:
+        return task_key(self.kind, self.task)
+
+
+def task_key(kind: str, name: str) -> str:
+    """The engine's name of a task: the package name for builds (colcon's), ``kind:name`` otherwise."""
+    return name if kind == "build" else f"{kind}:{name}"
 
 
 @dataclass(frozen=True)
@@ -19,7 +33,7 @@ class TaskQueued(Event):
 
 @dataclass(frozen=True)
 class TaskStarted(Event):
-    pass
+    reasons: tuple[str, ...] = ()  # why it is not up to date (empty when it has no up-to-date check)
 
 
 @dataclass(frozen=True)
@@ -38,11 +52,6 @@ class CommandEnded(Event):
 class TaskOutput(Event):
     stream: str = "stdout"  # or "stderr"
     data: bytes = b""
-
-
-@dataclass(frozen=True)
-class TaskProgress(Event):
-    percent: int = 0
 
 
 @dataclass(frozen=True)

@@ -26,6 +26,7 @@ from roc.engine.events import (
     Tick,
 )
 from roc.engine.process import TaskCancelled, TaskContext, TaskError
+from roc.messages import warn
 from roc.engine.ready import ReadyQueue, Task
 
 Handler = Callable[[Event], None]
@@ -46,21 +47,27 @@ class RunResult:
         return not (self.failed or self.aborted or self.skipped or self.not_started or self.interrupted)
 
 
-def _work(task: Task, context: TaskContext) -> None:
-    context.emit(TaskStarted(task.name))
+def _work(task: Task, context: TaskContext, reasons: tuple[str, ...]) -> None:
+    context.emit(TaskStarted(task.name, task.kind, reasons=reasons))
     start = time.monotonic()
     try:
         if context.cancelled:
             raise TaskCancelled
-        cached = task.action(context)
+        task.action(context)
     except TaskCancelled:
-        context.emit(TaskAborted(task.name, duration=time.monotonic() - start))
+        context.emit(TaskAborted(task.name, task.kind, duration=time.monotonic() - start))
     except TaskError as error:
-        context.emit(TaskFailed(task.name, duration=time.monotonic() - start, reason=str(error)))
+        context.emit(TaskFailed(task.name, task.kind, duration=time.monotonic() - start, reason=str(error)))
     except Exception:  # noqa: BLE001 - a bug in an action must fail its task, not hang the run
-        context.emit(TaskFailed(task.name, duration=time.monotonic() - start, reason=traceback.format_exc()))
+        context.emit(TaskFailed(task.name, task.kind, duration=time.monotonic() - start,
+                                reason=traceback.format_exc()))
     else:
-        context.emit(TaskFinished(task.name, duration=time.monotonic() - start, cached=bool(cached)))
+        context.emit(TaskFinished(task.name, task.kind, duration=time.monotonic() - start))
+
+
+def _check(task: Task) -> list[str] | None:
+    """The reasons ``task`` must run (empty: up to date), or None when it has no check."""
+    return None if task.check is None else list(task.check())
 
 
 def execute(
@@ -73,9 +80,11 @@ def execute(
 
     Without ``continue_on_error`` the first failure stops the running tasks (aborted) and starts no
     more; with it, only the tasks depending on a failed one are skipped. Ctrl+C and SIGTERM stop every
-    running process tree and end the run with ``interrupted`` set.
+    running process tree and end the run with ``interrupted`` set. A handler that raises is reported
+    on stderr and left out of the rest of the run (the run goes on), except for a closed stdout
+    (BrokenPipeError), which stops the run and is raised at its end.
     """
-    by_name = {t.name: t for t in tasks}
+    by_name = {t.key: t for t in tasks}
     ready = ReadyQueue(by_name)
     handlers = list(handlers)
     limit = workers if workers > 0 else max(1, len(by_name))
@@ -85,8 +94,15 @@ def execute(
     stopping = False
 
     def dispatch(event: Event) -> None:
-        for handler in handlers:
-            handler(event)
+        for handler in list(handlers):
+            try:
+                handler(event)
+            except BrokenPipeError:
+                raise
+            except Exception as error:  # noqa: BLE001 - one broken output must not break the build
+                handlers.remove(handler)
+                name = getattr(handler, "name", type(handler).__name__)
+                warn(f"event handler '{name}' failed and was disabled: {type(error).__name__}: {error}")
 
     def stop_running() -> None:
         for context in list(running.values()):
@@ -94,24 +110,26 @@ def execute(
 
     def settle(event: Event) -> None:
         nonlocal stopping
+        key = event.key
         if isinstance(event, TaskFinished):
-            result.finished.append(event.task)
-            ready.done(event.task)
+            result.finished.append(key)
+            ready.done(key)
         elif isinstance(event, TaskFailed):
-            result.failed.append(event.task)
+            result.failed.append(key)
             if continue_on_error:
-                blocked = [n for n in ready.downstream(event.task) if n not in result.skipped]
+                blocked = [k for k in ready.downstream(key) if k not in result.skipped]
                 ready.drop(blocked)
-                for name in blocked:
-                    result.skipped[name] = event.task
-                    dispatch(TaskSkipped(name, because_of=event.task))
+                for blocked_key in blocked:
+                    result.skipped[blocked_key] = key
+                    task = by_name[blocked_key]
+                    dispatch(TaskSkipped(task.name, task.kind, because_of=key))
             elif not stopping:
                 stopping = True
                 stop_running()
         elif isinstance(event, TaskAborted):
-            result.aborted.append(event.task)
+            result.aborted.append(key)
         if isinstance(event, (TaskFinished, TaskFailed, TaskAborted)):
-            running.pop(event.task, None)
+            running.pop(key, None)
 
     interrupt = threading.Event()
 
@@ -131,7 +149,7 @@ def execute(
         nonlocal failure, stopping
         try:
             dispatch(event)
-        except Exception as error:  # e.g. stdout closed under a JSON consumer: stop, then report it
+        except BrokenPipeError as error:  # stdout closed under a JSON consumer: stop, then report it
             if failure is None:
                 failure = error
             if not stopping:
@@ -141,20 +159,25 @@ def execute(
             settle(event)
 
     try:
-        for name in by_name:
-            handle(TaskQueued(name))
+        for task in by_name.values():
+            handle(TaskQueued(task.name, task.kind))
         while True:
             if interrupt.is_set() and not result.interrupted:
                 result.interrupted = stopping = True
                 stop_running()
             while not stopping and ready.has_ready() and len(running) < limit:
                 task = ready.pop()
-                if task.up_to_date:
-                    handle(TaskFinished(task.name, cached=True))
+                try:
+                    reasons = _check(task)
+                except Exception as error:  # noqa: BLE001 - a broken check fails its task, not the run
+                    handle(TaskFailed(task.name, task.kind, reason=f"up-to-date check failed: {error}"))
                     continue
-                context = TaskContext(task.name, events.put)
-                pool.submit(_work, task, context)
-                running[task.name] = context
+                if reasons == []:
+                    handle(TaskFinished(task.name, task.kind, cached=True))
+                    continue
+                context = TaskContext(task.name, events.put, task.kind)
+                pool.submit(_work, task, context, tuple(reasons or ()))
+                running[task.key] = context
             if not running:
                 break
             try:

@@ -47,12 +47,16 @@ def stop_process_tree(pid: int, grace: float = STOP_GRACE_SECONDS) -> None:
 class TaskContext:
     """What a task's action gets: a way to emit events and to run commands that can be stopped."""
 
-    def __init__(self, name: str, emit: Callable[[Event], None]):
+    def __init__(self, name: str, emit: Callable[[Event], None], kind: str = "build"):
         self.name = name
-        self.emit = emit
+        self.kind = kind
+        self._emit = emit
         self._lock = threading.Lock()
         self._process: subprocess.Popen | None = None
         self.cancelled = False
+
+    def emit(self, event: Event) -> None:
+        self._emit(event)
 
     def cancel(self) -> None:
         """Stop the running command (if any) and every command this task would start."""
@@ -74,7 +78,7 @@ class TaskContext:
         with self._lock:
             if self.cancelled:
                 raise TaskCancelled
-            self.emit(CommandStarted(self.name, command=command, cwd=str(cwd)))
+            self.emit(CommandStarted(self.name, self.kind, command=command, cwd=str(cwd)))
             try:
                 process = subprocess.Popen(
                     command, cwd=cwd, env=dict(env), stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
@@ -88,7 +92,7 @@ class TaskContext:
         with self._lock:
             self._process = None
             cancelled = self.cancelled
-        self.emit(CommandEnded(self.name, command=command, returncode=returncode))
+        self.emit(CommandEnded(self.name, self.kind, command=command, returncode=returncode))
         if cancelled:
             raise TaskCancelled
         return returncode
@@ -105,6 +109,6 @@ class TaskContext:
                         selector.unregister(key.fileobj)
                         open_streams -= 1
                         continue
-                    self.emit(TaskOutput(self.name, stream=key.data, data=data))
+                    self.emit(TaskOutput(self.name, self.kind, stream=key.data, data=data))
         process.stdout.close()
         process.stderr.close()

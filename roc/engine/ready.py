@@ -5,16 +5,28 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
+from roc.engine.events import task_key
+
 
 @dataclass
 class Task:
-    """A node of the graph. ``action`` runs in a worker; it raises TaskError to fail."""
+    """A node of the graph. ``action`` runs in a worker; it raises TaskError to fail.
 
-    name: str
-    dependencies: set[str]
+    ``check``, when given, runs when the task is about to be dispatched (after its dependencies have
+    finished, so it sees what they produced) and returns the reasons the task must run; an empty list
+    finishes the task as cached without taking a worker.
+    """
+
+    name: str  # what the task works on (a package, a probe)
+    dependencies: set[str]  # keys of the tasks it waits for
     action: Callable  # (TaskContext) -> None
+    kind: str = "build"  # build, idl, test, probe, ...
     weight: float = 1.0  # expected duration (seconds, or 1.0 when unknown)
-    up_to_date: bool = False  # finishes as cached without running (and without taking a worker)
+    check: Callable[[], list[str]] | None = None
+
+    @property
+    def key(self) -> str:
+        return task_key(self.kind, self.name)
 
 
 @dataclass
@@ -25,7 +37,7 @@ class ReadyQueue:
     it, so the chain that bounds the total time starts as early as possible.
     """
 
-    tasks: dict[str, Task]
+    tasks: dict[str, Task]  # by key
     _waiting_on: dict[str, set[str]] = field(init=False)
     _dependents: dict[str, set[str]] = field(init=False)
     _priority: dict[str, float] = field(init=False)

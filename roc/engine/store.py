@@ -22,7 +22,7 @@ class DurationStore:
 
     def __call__(self, event: Event) -> None:
         if isinstance(event, TaskFinished) and not event.cached:
-            self.durations[event.task] = round(event.duration, 3)
+            self.durations[event.key] = round(event.duration, 3)
 
     def save(self) -> None:
         write_text_atomic(self.path, json.dumps(self.durations, indent=1, sort_keys=True))

@@ -16,6 +16,7 @@ from roc.engine.events import (
     TaskSkipped,
     TaskStarted,
 )
+from roc.handlers.logs import task_log_folder
 
 
 def format_duration(seconds: float) -> str:
@@ -40,12 +41,13 @@ class ConsoleHandler:
 
     def __init__(self, stream: TextIO = sys.stdout, *, start_end: bool = True, stderr: bool = True,
                  summary: bool = True, direct: bool = False, cohesion: bool = False, log_path: str | None = None,
-                 status=None):
+                 status=None, kind: str = "build"):
         self.stream = stream
         self.status = status  # a StatusLine on a terminal: lines are printed above it
         self.start_end, self.stderr, self.summary = start_end, stderr, summary
         self.direct, self.cohesion = direct, cohesion
         self.log_path = log_path
+        self.kind = kind  # the run's own kind of task (its logs are not in a kind subfolder)
         self.started_at = time.monotonic()
         self._stderr: dict[str, bytearray] = {}
         self._all: dict[str, bytearray] = {}
@@ -75,15 +77,15 @@ class ConsoleHandler:
                 target.write(event.data.decode(errors="replace"))
                 target.flush()
             if event.stream == "stderr":
-                self._stderr.setdefault(event.task, bytearray()).extend(event.data)
-            self._all.setdefault(event.task, bytearray()).extend(event.data)
+                self._stderr.setdefault(event.key, bytearray()).extend(event.data)
+            self._all.setdefault(event.key, bytearray()).extend(event.data)
         elif isinstance(event, TaskStarted):
             if self.start_end:
-                self._print(f"Starting >>> {event.task}")
+                self._print(f"Starting >>> {event.key}")
         elif isinstance(event, (TaskFinished, TaskFailed, TaskAborted)):
             self._ended(event)
         elif isinstance(event, TaskSkipped):
-            self.skipped[event.task] = event.because_of
+            self.skipped[event.key] = event.because_of
         elif isinstance(event, RunFinished):
             if self.status is not None:
                 self.status(event)  # stops the live line, before the summary
@@ -94,11 +96,11 @@ class ConsoleHandler:
             self.status(event)
 
     def _ended(self, event: Event) -> None:
-        name = event.task
+        name = event.key  # a package name for builds (as colcon prints it), kind:name for other tasks
         if self.cohesion and name in self._all:
             self._print(f"--- output: {name}\n{self._all[name].decode(errors='replace').rstrip()}\n---")
         elif self.stderr and not self.direct and name in self._stderr:
-            where = f" (log: {self.log_path}/{name}/stderr.log)" if self.log_path else ""
+            where = f" (log: {self.log_path}/{task_log_folder(event, self.kind)}/stderr.log)" if self.log_path else ""
             self._print(f"--- stderr: {name}{where}\n{self._stderr[name].decode(errors='replace').rstrip()}\n---")
         if isinstance(event, TaskFinished):
             (self.cached if event.cached else self.finished).append(name)

@@ -1,5 +1,8 @@
-"""colcon's log layout: ``<log-base>/build_<time>/`` with an events log and per-package logs,
-``latest_build`` and ``latest`` links, and each package's result in ``<build-base>/<pkg>/colcon_build.rc``."""
+"""colcon's log layout: ``<log-base>/<verb>_<time>/`` with an events log and per-package logs,
+``latest_<verb>`` and ``latest`` links, and each package's result in ``<build-base>/<pkg>/colcon_<kind>.rc``.
+
+A run's own kind of task (``build`` for ``roc work build``) logs in ``<pkg>/`` as colcon does; any other
+kind of task in the same run (code generation before a build, say) logs in ``<pkg>/<kind>/``."""
 
 from __future__ import annotations
 
@@ -52,36 +55,46 @@ def new_log_directory(log_base: Path, verb: str = "build") -> Path:
     return directory
 
 
+def task_log_folder(event: Event, run_kind: str) -> str:
+    """A task's log folder, relative to the run's log directory."""
+    return event.task if event.kind == run_kind else f"{event.task}/{event.kind}"
+
+
 class LogHandler:
     """Per-package logs, and (unless ``event_log-``) every event in ``events.log``."""
 
-    def __init__(self, directory: Path, events: bool = True):
+    def __init__(self, directory: Path, events: bool = True, kind: str = "build"):
         self.directory = directory
+        self.kind = kind
         self._events = open(directory / "events.log", "a", buffering=1) if events else None
         self._files: dict[tuple[str, str], object] = {}
 
-    def _file(self, task: str, name: str):
-        key = (task, name)
+    def task_directory(self, event: Event) -> Path:
+        return self.directory / task_log_folder(event, self.kind)
+
+    def _file(self, event: Event, name: str):
+        key = (event.key, name)
         if key not in self._files:
-            (self.directory / task).mkdir(exist_ok=True)
-            self._files[key] = open(self.directory / task / name, "ab")
+            directory = self.task_directory(event)
+            directory.mkdir(parents=True, exist_ok=True)
+            self._files[key] = open(directory / name, "ab")
         return self._files[key]
 
     def __call__(self, event: Event) -> None:
         if isinstance(event, Tick):
             return
         if isinstance(event, TaskOutput):
-            self._file(event.task, f"{event.stream}.log").write(event.data)
-            self._file(event.task, "stdout_stderr.log").write(event.data)
-            self._file(event.task, "streams.log").write(event.data)
+            self._file(event, f"{event.stream}.log").write(event.data)
+            self._file(event, "stdout_stderr.log").write(event.data)
+            self._file(event, "streams.log").write(event.data)
         elif isinstance(event, CommandStarted):
             text = f"Invoking command in '{event.cwd}': {shlex.join(event.command)}\n".encode()
-            self._file(event.task, "command.log").write(text)
-            self._file(event.task, "streams.log").write(text)
+            self._file(event, "command.log").write(text)
+            self._file(event, "streams.log").write(text)
         elif isinstance(event, CommandEnded):
             text = f"Invoked command '{shlex.join(event.command)}' returned '{event.returncode}'\n".encode()
-            self._file(event.task, "command.log").write(text)
-            self._file(event.task, "streams.log").write(text)
+            self._file(event, "command.log").write(text)
+            self._file(event, "streams.log").write(text)
         if self._events is not None:
             self._events.write(event_json(event) + "\n")
         if isinstance(event, RunFinished):
@@ -95,8 +108,12 @@ class LogHandler:
             self._events.close()
 
 
+# Where each kind of task leaves its result, as colcon does (other kinds keep none).
+RESULT_FILES = {"build": "colcon_build.rc", "test": "colcon_test.rc"}
+
+
 class ResultStore:
-    """Writes each package's result where --packages-select-build-failed looks for it."""
+    """Writes each package's result where --packages-select-build-failed (or -test-failures) looks."""
 
     def __init__(self, build_base: Path):
         self.build_base = build_base
@@ -104,8 +121,8 @@ class ResultStore:
     def __call__(self, event: Event) -> None:
         results = {TaskFinished: "0", TaskFailed: "1", TaskAborted: INTERRUPTED_RESULT}
         result = results.get(type(event))
-        if result is not None:
-            write_text_atomic(self.build_base / event.task / "colcon_build.rc", result + "\n")
+        if result is not None and event.kind in RESULT_FILES:
+            write_text_atomic(self.build_base / event.task / RESULT_FILES[event.kind], result + "\n")
 
 
 class JsonEventsHandler:

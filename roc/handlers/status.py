@@ -58,13 +58,13 @@ class StatusLine:
         if isinstance(event, TaskQueued):
             self.total += 1
         elif isinstance(event, TaskStarted):
-            self.running[event.task] = None
-        elif isinstance(event, TaskOutput) and event.task in self.running:
+            self.running[event.key] = None
+        elif isinstance(event, TaskOutput) and event.key in self.running:
             percent = progress_of(event.data)
             if percent is not None:
-                self.running[event.task] = percent
+                self.running[event.key] = percent
         elif isinstance(event, (TaskFinished, TaskFailed, TaskAborted, TaskSkipped)):
-            self.running.pop(event.task, None)
+            self.running.pop(event.key, None)
             self.done += 1
         elif isinstance(event, RunFinished):
             self.live.stop()

@@ -1,0 +1,132 @@
+"""Is a package up to date, and if not, why: fingerprints computed in dependency order.
+
+A build computes each package's fingerprint when its task is dispatched, after its dependencies
+have been built, so it sees what they installed; ``roc work build --explain`` and the cache keys
+compute them all at once, in the same order.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from roc.builder.environment import base_environment
+from roc.builder.fingerprint import (
+    changes,
+    combine,
+    external_stamp,
+    source_parts,
+    source_stamps,
+    toolchain_parts,
+    build_tools,
+    underlay_prefixes,
+)
+from roc.builder.layout import package_prefix
+from roc.builder.state import install_intact, read_state
+from roc.buildtypes.context import BuildOptions
+from roc.workspace.dependencies import recursive_dependencies
+from roc.workspace.load import Workspace
+from roc.workspace.package import Package
+
+
+@dataclass
+class PackageState:
+    """One package now (fingerprint, its parts, the file stamps to store) and at its last build."""
+
+    fingerprint: str
+    parts: dict
+    files: dict
+    stored: dict  # roc_state.json as read: {} when never built
+
+
+def _options_parts(package: Package, options: BuildOptions) -> dict:
+    """The options that shape this package's build (no absolute paths: a restored cache may live in
+    another directory)."""
+    cmake_based = package.build_type in ("cmake", "ament_cmake")
+    return {
+        "type": package.type,
+        "merge-install": options.merge_install,
+        "symlink-install": options.symlink_install,
+        "cmake-args": list(options.cmake_args_for(package.name)) if cmake_based else [],
+        "ament-cmake-args": list(options.ament_cmake_args_for(package.name))
+        if package.build_type == "ament_cmake" else [],
+    }
+
+
+class Fingerprints:
+    """Fingerprints of the workspace's packages. A package that is not computed (not selected) counts
+    with the fingerprint of its last successful build (what is installed), if any."""
+
+    def __init__(self, workspace: Workspace, options: BuildOptions):
+        self.workspace, self.options = workspace, options
+        self.environment = base_environment()
+        self._prefixes = underlay_prefixes(self.environment, options.install_base)
+        self._external: dict[str, str | None] = {}
+        self._now: dict[str, str] = {}
+
+    def _fingerprint(self, name: str) -> str | None:
+        if name in self._now:
+            return self._now[name]
+        return read_state(self.options.build_base / name).get("fingerprint")
+
+    def _underlay(self, name: str) -> str | None:
+        if name not in self._external:
+            self._external[name] = external_stamp(name, self._prefixes)
+        return self._external[name]
+
+    def compute(self, package: Package) -> PackageState:
+        """The package's state now; its dependencies must have been computed (or built) first."""
+        by_name = self.workspace.by_name
+        stored = read_state(self.options.build_base / package.name)
+        files = source_stamps((self.workspace.root / package.path).resolve(), stored.get("files", {}))
+        tools = build_tools(package.build_type, self.environment, self.options.cmake_args_for(package.name))
+        parts = {
+            "sources": source_parts(files),
+            "options": _options_parts(package, self.options),
+            "toolchain": toolchain_parts(self.environment, self.options.install_base, tools),
+            "dependencies": {n: self._fingerprint(n) for n in sorted(recursive_dependencies(package, by_name))},
+            "underlay": {n: self._underlay(n) for n in sorted(package.direct_dependencies() - by_name.keys())},
+        }
+        fingerprint = combine(parts)
+        self._now[package.name] = fingerprint
+        return PackageState(fingerprint, parts, files, stored)
+
+
+def forced_reasons(options: BuildOptions) -> list[str]:
+    """The options that build every selected package whatever its state."""
+    flags = [("--no-cache", not options.use_state), ("--force", options.force),
+             ("--cmake-target (a partial build is never recorded as up to date)", options.partial()),
+             ("--cmake-clean-cache", options.cmake_clean_cache), ("--cmake-clean-first", options.cmake_clean_first),
+             ("--cmake-force-configure", options.cmake_force_configure)]
+    return [flag for flag, given in flags if given]
+
+
+def stale_reasons(package: Package, state: PackageState, options: BuildOptions) -> list[str]:
+    """Why the package must be built (empty: it is up to date)."""
+    forced = forced_reasons(options)
+    if forced:
+        return forced
+    stored = state.stored
+    if not stored:
+        return ["never built"]
+    if stored.get("fingerprint") is None:
+        return ["its last build did not succeed"]
+    if stored["fingerprint"] != state.fingerprint:
+        return changes(stored.get("parts") or {}, state.parts) or ["built by another version of roc"]
+    build_dir = options.build_base / package.name
+    if not install_intact(package_prefix(options.install_base, package.name, options.merge_install),
+                          package.name, build_dir):
+        return ["its install is incomplete (files of its last install are missing)"]
+    return []
+
+
+def explain(workspace: Workspace, options: BuildOptions) -> list[tuple[str, list[str]]]:
+    """Each selected package, in build order, with why it would be built (empty: up to date)."""
+    fingerprints = Fingerprints(workspace, options)
+    return [(p.name, stale_reasons(p, fingerprints.compute(p), options)) for p in workspace.selected_in_order()]
+
+
+def fingerprint_packages(workspace: Workspace, options: BuildOptions) -> dict[str, PackageState]:
+    """The state of every selected package now, by name."""
+    fingerprints = Fingerprints(workspace, options)
+    return {p.name: fingerprints.compute(p) for p in workspace.selected_in_order()}
