@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import io
+from pathlib import Path
+
+from build_helpers import copy_fixture, roc
 
 from roc.engine.events import Tick, TaskOutput, TaskQueued, TaskStarted
 
@@ -50,3 +53,13 @@ def test_status_line_redraws_only_on_change_and_at_most_four_times_a_second():
         now[0] += 0.01
         status(Tick(""))
     assert len(live.updates) == 3 + 10
+
+
+def test_paths_entries_that_are_not_directories_are_ignored(tmp_path: Path) -> None:
+    workspace = copy_fixture("selection", tmp_path / "ws")
+    (workspace / "src" / "README.md").write_text("a file beside the packages\n")
+    # what a shell makes of 'src/*' (and a path that does not exist at all)
+    paths = sorted(str(p.relative_to(workspace)) for p in (workspace / "src").iterdir())
+    result = roc("work", "list", "-n", "--paths", *paths, "src/missing", cwd=workspace)
+    assert result.returncode == 0, result.stderr
+    assert "core" in result.stdout.split() and len(result.stdout.split()) == 10

@@ -75,7 +75,6 @@ def test_unknown_package_is_a_usage_error_with_a_hint(tmp_path: Path) -> None:
 @pytest.mark.parametrize("arguments, message", [
     (["--packages-above-depth", "x", "core"], "--packages-above-depth: the first value must be a depth"),
     (["--packages-select-regex", "("], "--packages-select-regex: invalid pattern '('"),
-    (["--paths", "src/missing"], "--paths: 'src/missing' is not a directory"),
     (["--base-paths", "nowhere"], "--base-paths: 'nowhere' is not a directory"),
     (["--packages-start", "tool", "--packages-end", "core"], "comes before --packages-start 'tool'"),
     (["--no-such-option"], "unrecognized arguments: --no-such-option"),
