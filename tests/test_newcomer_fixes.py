@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import io
+import os
+import sys
 from pathlib import Path
 
-from build_helpers import copy_fixture, roc
+import pytest
+from build_helpers import copy_fixture, roc, ros_env
 
 from roc.engine.events import Tick, TaskOutput, TaskQueued, TaskStarted
 
@@ -63,3 +66,75 @@ def test_paths_entries_that_are_not_directories_are_ignored(tmp_path: Path) -> N
     result = roc("work", "list", "-n", "--paths", *paths, "src/missing", cwd=workspace)
     assert result.returncode == 0, result.stderr
     assert "core" in result.stdout.split() and len(result.stdout.split()) == 10
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (["work", "build", "--symlink-instal"],
+     "roc: error: unrecognized arguments: --symlink-instal; did you mean --symlink-install? "
+     "(see 'roc work build --help')"),
+    (["work", "list", "--packages-sel", "core"], "did you mean --packages-select?"),
+    (["work", "build", "--mixin", "release"], "roc: error: roc does not support --mixin (colcon-mixin; "),
+    (["work", "build", "--mixin-files", "x.mixin"], "roc does not support --mixin-files (colcon-mixin; "),
+    (["work", "lst"], "(see 'roc work --help')"),
+    (["work", "build", "--parallel-workers", "x"], "(see 'roc work build --help')"),
+    (["work", "list", "--packages-above-depth"], "(see 'roc work list --help')"),
+    (["nope"], "(see 'roc --help')"),
+])
+def test_usage_errors_are_one_roc_error_line_pointing_at_the_verbs_help(arguments, message, tmp_path: Path) -> None:
+    workspace = copy_fixture("selection", tmp_path / "ws")
+    result = roc(*arguments, cwd=workspace)
+    assert result.returncode == 2
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("roc: error: ") and message in lines[0], result.stderr
+
+
+def test_allow_abbrev_is_off_in_every_parser() -> None:
+    from roc.cli.commands import build_parser
+
+    parser = build_parser()
+    assert not parser.allow_abbrev and all(not leaf.allow_abbrev for leaf in parser.leaves.values())
+
+
+def _underlay(tmp_path: Path) -> Path:
+    """An installed underlay with 'pyp' (as in build_small) and 'user', which needs pyp at run time."""
+    prefix = tmp_path / "underlay"
+    index = prefix / "share" / "ament_index" / "resource_index" / "packages"
+    index.mkdir(parents=True)
+    for name in ("pyp", "user", "leaf"):
+        (index / name).write_text("")
+    (prefix / "share" / "user").mkdir()
+    (prefix / "share" / "user" / "package.xml").write_text(
+        '<package format="3"><name>user</name><version>1.0.0</version><description>d</description>'
+        '<maintainer email="m@example.com">M</maintainer><license>MIT</license>'
+        "<exec_depend>pyp</exec_depend></package>\n")
+    return prefix
+
+
+@pytest.mark.slow
+def test_overriding_an_underlay_package_warns_unless_allowed(tmp_path: Path) -> None:
+    workspace = copy_fixture("build_small", tmp_path / "ws")
+    prefix = _underlay(tmp_path)
+    env = ros_env(AMENT_PREFIX_PATH=f"{prefix}{os.pathsep}{sys.prefix}")
+    warned = roc("work", "build", "--packages-select", "pyp", cwd=workspace, env=env)
+    assert warned.returncode == 0, warned.stderr
+    assert "roc: warning: some selected packages are already installed in an underlay workspace" in warned.stderr
+    assert f"'pyp' is in: {prefix}" in warned.stderr
+    assert "--allow-overriding pyp" in warned.stderr
+    allowed = roc("work", "build", "--packages-select", "pyp", "--allow-overriding", "pyp", "nothere",
+                  cwd=workspace, env=env)
+    assert allowed.returncode == 0, allowed.stderr
+    assert "underlay" not in allowed.stderr
+    assert "--allow-overriding: ignoring unknown package 'nothere'" in allowed.stderr
+
+
+def test_overriding_an_unused_underlay_package_does_not_warn(tmp_path: Path) -> None:
+    from roc.workspace.underlay import overridden_packages
+
+    prefix = _underlay(tmp_path)
+    env = {"AMENT_PREFIX_PATH": str(prefix)}
+    assert overridden_packages({"leaf"}, tmp_path / "install", [], env) == {}
+    assert overridden_packages({"pyp", "leaf"}, tmp_path / "install", [], env) == {"pyp": [prefix]}
+    # once this workspace builds 'user' too, nothing in the underlay uses the old pyp
+    assert overridden_packages({"pyp", "user"}, tmp_path / "install", [], env) == {}
+    # an underlay that is this workspace's own install base is not an underlay
+    assert overridden_packages({"pyp"}, prefix, [], env) == {}
