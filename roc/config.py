@@ -30,6 +30,9 @@ from roc.errors import UsageError
 VERBS = ("list", "info", "graph", "build", "env", "cache", "create")
 PACKAGE_KEYS = {"cmake-args": list, "ament-cmake-args": list, "skip": bool}
 ROC_TOML = "roc.toml"
+# Options naming a directory: a relative value in roc.toml or colcon_defaults.yaml is taken from that
+# file's directory (--base-paths and --paths too: discovery then starts from there, see load.resolve_root).
+DIRECTORY_OPTIONS = ("build_base", "install_base", "log_base", "test_result_base")
 
 
 class ConfigError(UsageError):
@@ -58,9 +61,15 @@ class Setting:
 
 
 class Configuration:
-    def __init__(self) -> None:
+    def __init__(self, root: Path | None = None) -> None:
+        self.root = root  # the workspace root, where roc.toml and colcon_defaults.yaml are
         self.layers: list[dict[str, Setting]] = []  # lowest precedence first
         self.packages: dict[str, dict[str, Setting]] = {}
+        self.applied: dict[str, object] = {}  # argparse dest -> the default it was given
+
+    def from_configuration(self, args: argparse.Namespace, dest: str) -> bool:
+        """Whether ``args.<dest>`` is the configured value (not given on the command line)."""
+        return dest in self.applied and getattr(args, dest, None) is self.applied[dest]
 
     def add_layer(self, values: dict, source: str, path: Path, table: str, text: str | None) -> None:
         layer = {}
@@ -131,7 +140,7 @@ def meta_files(root: Path, metas: list[str] | None, ignore_user_meta: bool) -> l
 
 def load_configuration(root: Path, verb: str, profile: str | None, metas: list[str] | None = None,
                        ignore_user_meta: bool = False) -> Configuration:
-    config = Configuration()
+    config = Configuration(root)
     _load_colcon_defaults(config, root, verb)
     for path in meta_files(root, metas, ignore_user_meta):
         _load_colcon_meta(config, path)
@@ -260,5 +269,9 @@ def apply_configuration(parser: argparse.ArgumentParser, config: Configuration) 
             raise ConfigError(setting.path, key, f"not an option of this verb; options: {' '.join(options)}",
                               setting.line)
         applied[action.dest] = setting
-        parser.set_defaults(**{action.dest: _check_type(setting, action)})
+        value = _check_type(setting, action)
+        if action.dest in DIRECTORY_OPTIONS and setting.path.parent == config.root:
+            value = str(setting.path.parent / value)  # relative to roc.toml's directory, wherever roc runs
+        config.applied[action.dest] = value
+        parser.set_defaults(**{action.dest: value})
     return applied

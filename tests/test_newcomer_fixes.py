@@ -138,3 +138,31 @@ def test_overriding_an_unused_underlay_package_does_not_warn(tmp_path: Path) -> 
     assert overridden_packages({"pyp", "user"}, tmp_path / "install", [], env) == {}
     # an underlay that is this workspace's own install base is not an underlay
     assert overridden_packages({"pyp"}, prefix, [], env) == {}
+
+
+def test_configured_base_paths_are_relative_to_roc_toml_from_a_subdirectory(tmp_path: Path) -> None:
+    workspace = copy_fixture("selection", tmp_path / "ws")
+    (workspace / "roc.toml").write_text('[defaults]\nbase-paths = ["src"]\n')
+    expected = roc("work", "list", cwd=workspace)
+    assert expected.returncode == 0, expected.stderr
+    for directory in (workspace / "src", workspace / "src" / "core"):
+        result = roc("work", "list", cwd=directory)
+        assert result.returncode == 0, result.stderr
+        assert result.stdout == expected.stdout and "src/core" in result.stdout
+    # the command line's --base-paths is still taken from the current directory, as in colcon
+    here = roc("work", "list", "-n", "--base-paths", ".", cwd=workspace / "src" / "core")
+    assert here.stdout.split() == ["core"]
+
+
+def test_configured_directories_are_relative_to_roc_toml(tmp_path: Path, monkeypatch) -> None:
+    from roc.cli.commands import build_parser
+    from roc.config import apply_configuration, load_configuration
+
+    (tmp_path / "roc.toml").write_text('[build]\nbuild-base = "out/build"\ninstall-base = "/abs/install"\n')
+    (tmp_path / "sub").mkdir()
+    monkeypatch.chdir(tmp_path / "sub")
+    parser = build_parser(["work", "build"])
+    leaf = parser.leaves[("work", "build")]
+    apply_configuration(leaf, load_configuration(tmp_path, "build", None))
+    args = leaf.parse_args([])
+    assert args.build_base == str(tmp_path / "out" / "build") and args.install_base == "/abs/install"

@@ -34,10 +34,13 @@ class Workspace:
 
 
 def resolve_root(args: argparse.Namespace) -> Path:
-    """Explicit --base-paths/--paths are taken from the current directory, as colcon does; otherwise
-    roc looks upward for the workspace root and says so when it is not the current directory."""
-    if args.base_paths is not None or args.paths is not None:
-        return Path.cwd()
+    """--base-paths/--paths given on the command line are taken from the current directory, as colcon
+    does; otherwise (also when roc.toml sets them) roc looks upward for the workspace root and says so
+    when it is not the current directory."""
+    config = getattr(args, "configuration", None)
+    for dest in ("base_paths", "paths"):
+        if getattr(args, dest) is not None and not (config and config.from_configuration(args, dest)):
+            return Path.cwd()
     return find_workspace_root_for(args)
 
 
