@@ -166,3 +166,22 @@ def test_configured_directories_are_relative_to_roc_toml(tmp_path: Path, monkeyp
     apply_configuration(leaf, load_configuration(tmp_path, "build", None))
     args = leaf.parse_args([])
     assert args.build_base == str(tmp_path / "out" / "build") and args.install_base == "/abs/install"
+
+
+@pytest.mark.parametrize("toml, message", [
+    ('[package.cor]\ncmake-args = ["-DX=1"]\n',
+     "roc.toml:1: '[package.cor]': no package named 'cor' in the workspace; did you mean 'core'?"),
+    ('[build]\n\n[ package."lib_c" ]\n', "roc.toml:3: '[package.lib_c]': no package named 'lib_c'"),
+    ("[list]\nbase-paths = [\"src\"\n", "roc.toml:2:20: invalid TOML: Unclosed array (at the end of the file)"),
+    ("[list]\nbase-paths = \n", "roc.toml:2:14: invalid TOML: Invalid value"),
+    ("[list]\npackages-selct = [\"core\"]\n",
+     "roc.toml:2: 'packages-selct': not an option of this verb; did you mean 'packages-select'? options: "),
+    ("[package.core]\ncmake-arg = []\n", "'cmake-arg': unknown package setting; did you mean 'cmake-args'?"),
+])
+def test_roc_toml_mistakes_name_the_line_and_the_closest_name(toml: str, message: str, tmp_path: Path) -> None:
+    workspace = copy_fixture("selection", tmp_path / "ws")
+    (workspace / "roc.toml").write_text(toml)
+    result = roc("work", "list", cwd=workspace / "src")
+    assert result.returncode == 2
+    lines = [line for line in result.stderr.splitlines() if not line.startswith("roc: using workspace root")]
+    assert len(lines) == 1 and message in lines[0], result.stderr

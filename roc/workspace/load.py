@@ -63,7 +63,13 @@ def load_workspace(args: argparse.Namespace) -> Workspace:
         return discover_packages(root, variables, args.base_paths, args.paths, visited)
 
     packages = cached_discovery(root, variables, args.base_paths, args.paths, discover)
-    check_selection_arguments(args, {p.name for p in packages})
+    names = {p.name for p in packages}
+    config = getattr(args, "configuration", None)
+    if config is not None:
+        from roc.config import check_package_tables
+
+        check_package_tables(config, names)
+    check_selection_arguments(args, names)
     ordered = topological_order(ignore_packages(args, packages))
     build_base = root / getattr(args, "build_base", "build")
     return Workspace(root=root, ordered=ordered, selected=select_packages(args, ordered, build_base))
