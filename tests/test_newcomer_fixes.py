@@ -185,3 +185,29 @@ def test_roc_toml_mistakes_name_the_line_and_the_closest_name(toml: str, message
     assert result.returncode == 2
     lines = [line for line in result.stderr.splitlines() if not line.startswith("roc: using workspace root")]
     assert len(lines) == 1 and message in lines[0], result.stderr
+
+
+def test_create_refuses_a_missing_parent_unless_asked(tmp_path: Path) -> None:
+    missing = tmp_path / "nonexistent" / "dir"
+    refused = roc("work", "create", "pkg_a", "--destination-directory", str(missing), cwd=tmp_path)
+    assert refused.returncode == 2
+    assert refused.stderr.startswith(f"roc: error: --destination-directory {missing}: {missing.parent} does not "
+                                     "exist; create it, or add --parents")
+    assert not (tmp_path / "nonexistent").exists()
+    made = roc("work", "create", "pkg_a", "--destination-directory", str(missing), "--parents", cwd=tmp_path)
+    assert made.returncode == 0, made.stderr
+    assert (missing / "pkg_a" / "package.xml").is_file()
+    # the destination itself may be new, as with mkdir
+    assert roc("work", "create", "pkg_b", "--destination-directory", "new", cwd=tmp_path).returncode == 0
+
+
+def test_create_refuses_a_name_the_workspace_already_has(tmp_path: Path) -> None:
+    workspace = copy_fixture("selection", tmp_path / "ws")
+    before = sorted(p.relative_to(workspace) for p in workspace.rglob("*"))
+    for destination in ("src", "src/new_group"):
+        result = roc("work", "create", "core", "--build-type", "ament_python", "--destination-directory",
+                     destination, cwd=workspace)
+        assert result.returncode == 2
+        assert result.stderr.startswith(f"roc: error: the workspace {workspace} already has a package named "
+                                        f"'core' (in {workspace / 'src' / 'core'}); choose another name")
+    assert sorted(p.relative_to(workspace) for p in workspace.rglob("*")) == before

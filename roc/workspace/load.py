@@ -53,16 +53,22 @@ def find_workspace_root_for(args: argparse.Namespace) -> Path:
     return root
 
 
-def load_workspace(args: argparse.Namespace) -> Workspace:
-    root = resolve_root(args)
+def discover_workspace(root: Path, base_paths: list[str] | None = None,
+                       paths: list[str] | None = None) -> list[Package]:
+    """The packages of the workspace at ``root`` (from the discovery cache when nothing changed)."""
     variables = condition_environment(os.environ)
 
     def discover(visited: list[str]) -> list[Package]:
         from roc.workspace.discovery import discover_packages
 
-        return discover_packages(root, variables, args.base_paths, args.paths, visited)
+        return discover_packages(root, variables, base_paths, paths, visited)
 
-    packages = cached_discovery(root, variables, args.base_paths, args.paths, discover)
+    return cached_discovery(root, variables, base_paths, paths, discover)
+
+
+def load_workspace(args: argparse.Namespace) -> Workspace:
+    root = resolve_root(args)
+    packages = discover_workspace(root, args.base_paths, args.paths)
     names = {p.name for p in packages}
     config = getattr(args, "configuration", None)
     if config is not None:
