@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import json
 import subprocess
 import os
 import sys
@@ -249,3 +250,30 @@ def test_env_prints_only_what_the_build_environment_changes(tmp_path: Path) -> N
     evaluated = subprocess.run(["bash", "-c", 'eval "$1" && echo "$CMAKE_PREFIX_PATH|$PATH"', "_", printed.stdout],
                                capture_output=True, text=True, env=env)
     assert evaluated.stdout.strip() == f"{str(tmp_path / 'install' / 'alpha')}|{env['PATH']}"
+
+
+@pytest.mark.slow
+def test_cache_export_says_what_it_left_out_and_why(tmp_path: Path) -> None:
+    workspace = tmp_path / "ws"
+    _plain_cmake(workspace, "alpha")
+    _plain_cmake(workspace, "beta", "find_package(alpha REQUIRED)\n")
+    _plain_cmake(workspace, "fixed")
+    with (workspace / "src" / "fixed" / "CMakeLists.txt").open("a") as cmake:
+        cmake.write('file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/where.txt "${CMAKE_INSTALL_PREFIX}")\n'
+                    "install(FILES ${CMAKE_CURRENT_BINARY_DIR}/where.txt DESTINATION share/fixed)\n")
+    _plain_cmake(workspace, "never_built")
+    built = roc("work", "build", "--packages-skip", "never_built", cwd=workspace)
+    assert built.returncode == 0, built.stdout + built.stderr
+    with (workspace / "src" / "alpha" / "CMakeLists.txt").open("a") as cmake:
+        cmake.write("# changed after the build\n")
+    result = roc("work", "cache", "export", str(tmp_path / "cache"), cwd=workspace)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout == f"exported 1 up-to-date package(s) to {tmp_path / 'cache'}\n"
+    assert result.stderr.splitlines() == [
+        f"  fixed: import can restore it only into {workspace} (share/fixed/where.txt holds that path)",
+        "  not exported: alpha: not up to date (it changed since its last build; build it first)",
+        "  not exported: beta: not up to date (it changed since its last build; build it first)",
+        "  not exported: never_built: not built successfully yet",
+    ]
+    index = json.loads((tmp_path / "cache" / "index.json").read_text())
+    assert sorted(index["packages"]) == ["fixed"]
