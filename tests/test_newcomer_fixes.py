@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import json
+import shutil
 import subprocess
 import os
 import sys
@@ -277,3 +278,82 @@ def test_cache_export_says_what_it_left_out_and_why(tmp_path: Path) -> None:
     ]
     index = json.loads((tmp_path / "cache" / "index.json").read_text())
     assert sorted(index["packages"]) == ["fixed"]
+
+
+def _completion_script(shell: str, directory: Path) -> Path:
+    result = roc("completion", shell, cwd=directory)
+    assert result.returncode == 0, result.stderr
+    path = directory / f"roc.{shell}"
+    path.write_text(result.stdout)
+    return path
+
+
+BASH_COMPLETIONS = [  # words after 'roc', the word completed last -> COMPREPLY
+    (["work", "build", "lib_"], "lib_a lib_b"),
+    (["work", "b", "core", "lib_"], "lib_a lib_b"),
+    (["work", "info", "t"], "test_helper tool"),
+    (["work", "env", "ap"], "app"),
+    (["work", "build", "--packages-select", "core", "lib_"], "lib_a lib_b"),  # every value of a list option
+    (["work", "list", "--packages-skip", "app", "--packages-ignore", "s"], "standalone"),
+    (["work", "build", "--packages-start", "core", "a"], "app"),  # after a one-value option: positional
+    (["work", "build", "--executor", "s"], "sequential"),
+    (["work", "build", "--event-handlers", "summary-", "status"], "status+ status-"),
+    (["work", "list", "--format", ""], "text json"),
+    (["work", "cache", "ex"], "export"),
+    (["work", "build", "--symlink-install", "--packages-up-to", "msg"], "msgs"),
+    (["work", "build", "--packages-select-reg"], "--packages-select-regex"),
+    (["work", "build", "--packages-select-regex", "li"], ""),  # a pattern: nothing to offer
+    (["completion", "f"], "fish"),
+]
+
+
+def test_bash_completes_positional_package_names_and_every_list_value(tmp_path: Path) -> None:
+    script = _completion_script("bash", tmp_path)
+    workspace = copy_fixture("selection", tmp_path / "ws")
+    probe = [f"source {script}"]
+    for words, _ in BASH_COMPLETIONS:
+        quoted = " ".join(f"'{w}'" for w in ["roc", *words])
+        probe.append(f'COMP_WORDS=({quoted}); COMP_CWORD={len(words)}; _roc_complete; echo "${{COMPREPLY[*]}}"')
+    result = subprocess.run(["bash", "-c", "\n".join(probe)], cwd=workspace, env=ros_env(), capture_output=True,
+                            text=True, timeout=120)
+    assert result.stdout.splitlines() == [expected for _, expected in BASH_COMPLETIONS], result.stderr
+
+
+def test_zsh_completes_with_the_bash_function(tmp_path: Path) -> None:
+    if shutil.which("zsh") is None:
+        pytest.skip("zsh is not installed (scripts/setup.sh installs it when apt is available)")
+    script = _completion_script("zsh", tmp_path)
+    assert subprocess.run(["zsh", "-n", str(script)], capture_output=True).returncode == 0
+    workspace = copy_fixture("selection", tmp_path / "ws")
+    # zsh's compgen emulation leaves filtering by the typed prefix to zsh's completion system (which this
+    # probe does not run), so each probe shows which kind of value was offered
+    probe = [f"source {script}", "setopt ksharrays"]  # as bashcompinit's _bash_complete does
+    for words in (["work", "build", "--packages-select", "core", "lib_"], ["work", "build", "--executor", "s"],
+                  ["work", "info", "x"]):
+        probe.append(f"COMP_WORDS=(roc {' '.join(words)}); COMP_CWORD={len(words)}; _roc_complete; "
+                     'echo "${COMPREPLY[*]}"')
+    result = subprocess.run(["zsh", "-f", "-c", "\n".join(probe)], cwd=workspace,
+                            env={**ros_env(), "HOME": str(tmp_path)}, capture_output=True, text=True, timeout=120)
+    packages = "app core extra lib_a lib_b msgs standalone test_helper tool util"
+    assert result.stdout.splitlines() == [packages, "parallel sequential", packages], result.stdout + result.stderr
+
+
+@pytest.mark.parametrize("line, expected", [
+    ("roc work build lib_", ["lib_a", "lib_b"]),
+    ("roc work info core t", ["test_helper", "tool"]),
+    ("roc work build --packages-select core lib_", ["lib_a", "lib_b"]),
+    ("roc work build --executor s", ["sequential"]),
+    ("roc work build --packages-start core a", ["app"]),
+    ("roc work env ap", ["app"]),
+])
+def test_fish_completes_positional_package_names_and_every_list_value(line: str, expected: list[str],
+                                                                       tmp_path: Path) -> None:
+    if shutil.which("fish") is None:
+        pytest.skip("fish is not installed (scripts/setup.sh installs it when apt is available)")
+    script = _completion_script("fish", tmp_path)
+    assert subprocess.run(["fish", "-n", str(script)], capture_output=True).returncode == 0
+    workspace = copy_fixture("selection", tmp_path / "ws")
+    probe = f"source {script}; complete -C '{line}'"
+    result = subprocess.run(["fish", "--no-config", "-c", probe], cwd=workspace,
+                            env={**ros_env(), "HOME": str(tmp_path)}, capture_output=True, text=True, timeout=120)
+    assert [row.split("\t")[0] for row in result.stdout.splitlines()] == expected, result.stderr

@@ -33,9 +33,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="packages built at once, 0 for no limit (default: the number of CPUs)")
     add("-j", "--jobs", type=int, metavar="N",
         help="compiler jobs of all packages together (default: -j of MAKEFLAGS, else the number of CPUs)")
-    add("--event-handlers", nargs="*", metavar="NAME+/-", default=[],
-        help="enable (+) or disable (-) output: console_start_end, console_stderr, console_direct, "
-             "console_cohesion, summary, status, log, event_log, store_result")
+    handlers = add("--event-handlers", nargs="*", metavar="NAME+/-", default=[],
+                   help="enable (+) or disable (-) output: console_start_end, console_stderr, console_direct, "
+                        "console_cohesion, summary, status, log, event_log, store_result")
+    handlers.completion = [f"{name}{sign}" for name in sorted(EVENT_HANDLERS) for sign in "+-"]
     add("--output", choices=("text", "json"), default="text", help="json: one JSON event per line on stdout")
     add("--allow-overriding", action="extend", nargs="+", default=[], metavar="PKG_NAME",
         help="build these packages without the warning that an underlay workspace has them too")
