@@ -357,3 +357,36 @@ def test_fish_completes_positional_package_names_and_every_list_value(line: str,
     result = subprocess.run(["fish", "--no-config", "-c", probe], cwd=workspace,
                             env={**ros_env(), "HOME": str(tmp_path)}, capture_output=True, text=True, timeout=120)
     assert [row.split("\t")[0] for row in result.stdout.splitlines()] == expected, result.stderr
+
+
+def _installed_links(prefix: Path) -> list[str]:
+    return sorted(str(p.relative_to(prefix)) for p in prefix.rglob("*") if p.is_symlink())
+
+
+@pytest.mark.slow
+def test_switching_symlink_install_on_and_off_on_an_existing_build_base(tmp_path: Path) -> None:
+    workspace = copy_fixture("build_small", tmp_path / "ws")
+    core = workspace / "src" / "core"
+    (core / "core_py").mkdir()
+    (core / "core_py" / "__init__.py").write_text("VALUE = 1\n")
+    cmake = (core / "CMakeLists.txt").read_text().replace(
+        "ament_package()", "find_package(ament_cmake_python REQUIRED)\nament_python_install_package(core_py)\n"
+                           "ament_package()")
+    (core / "CMakeLists.txt").write_text(cmake)
+    build = ("work", "build", "--packages-select", "core", "pyp")
+    first = roc(*build, cwd=workspace)
+    assert first.returncode == 0, first.stdout + first.stderr
+    install = workspace / "install"
+    assert _installed_links(install) == []
+    on = roc(*build, "--symlink-install", cwd=workspace)
+    assert on.returncode == 0, on.stdout + on.stderr  # was: "existing path cannot be removed: Is a directory"
+    header = install / "core" / "include" / "core" / "core.hpp"
+    assert header.is_symlink() and header.resolve() == (core / "include" / "core" / "core.hpp").resolve()
+    assert any("pyp" in link for link in _installed_links(install / "pyp"))
+    off = roc(*build, cwd=workspace)
+    assert off.returncode == 0, off.stdout + off.stderr
+    assert "AMENT_CMAKE_SYMLINK_INSTALL:BOOL=OFF" in (workspace / "build" / "core" / "CMakeCache.txt").read_text()
+    assert _installed_links(install) == [] and header.is_file()
+    assert (core / "core_py" / "__init__.py").read_text() == "VALUE = 1\n"
+    site = next((install / "core" / "lib").glob("python*/site-packages"))
+    assert (site / "core_py" / "__init__.py").read_text() == "VALUE = 1\n"
