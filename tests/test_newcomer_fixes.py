@@ -82,6 +82,9 @@ def test_paths_entries_that_are_not_directories_are_ignored(tmp_path: Path) -> N
     (["work", "build", "--parallel-workers", "x"], "(see 'roc work build --help')"),
     (["work", "list", "--packages-above-depth"], "(see 'roc work list --help')"),
     (["nope"], "(see 'roc --help')"),
+    (["w", "ls", "--packages-select-regex", "("], "invalid pattern '(': "),  # roc's own usage errors too
+    (["w", "ls", "--packages-select-regex", "("], "(see 'roc work list --help')"),
+    (["work", "build", "--parallel-workers", "-1"], "or more (see 'roc work build --help')"),
 ])
 def test_usage_errors_are_one_roc_error_line_pointing_at_the_verbs_help(arguments, message, tmp_path: Path) -> None:
     workspace = copy_fixture("selection", tmp_path / "ws")

@@ -66,7 +66,7 @@ def test_unknown_package_is_a_usage_error_with_a_hint(tmp_path: Path) -> None:
     assert close.returncode == 2
     line = assert_one_error_line(close.stderr)
     assert "--packages-up-to: no package named 'lib_c' in the workspace; did you mean " in line
-    assert line.endswith("?") and "lib_a" in line and "lib_b" in line
+    assert line.endswith("? (see 'roc work list --help')") and "lib_a" in line and "lib_b" in line
     far = run_roc("work", "graph", "--packages-above", "zzz", cwd=workspace)
     assert far.returncode == 2
     assert "run 'roc work list -n' to see the package names" in assert_one_error_line(far.stderr)
