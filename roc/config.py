@@ -30,6 +30,9 @@ from roc.errors import UsageError
 VERBS = ("list", "info", "graph", "build", "env", "cache", "create")
 PACKAGE_KEYS = {"cmake-args": list, "ament-cmake-args": list, "skip": bool}
 ROC_TOML = "roc.toml"
+# Options naming a directory: a relative value in roc.toml or colcon_defaults.yaml is taken from that
+# file's directory (--base-paths and --paths too: discovery then starts from there, see load.resolve_root).
+DIRECTORY_OPTIONS = ("build_base", "install_base", "log_base", "test_result_base")
 
 
 class ConfigError(UsageError):
@@ -58,9 +61,16 @@ class Setting:
 
 
 class Configuration:
-    def __init__(self) -> None:
+    def __init__(self, root: Path | None = None) -> None:
+        self.root = root  # the workspace root, where roc.toml and colcon_defaults.yaml are
         self.layers: list[dict[str, Setting]] = []  # lowest precedence first
         self.packages: dict[str, dict[str, Setting]] = {}
+        self.applied: dict[str, object] = {}  # argparse dest -> the default it was given
+        self.package_tables: dict[str, tuple[Path, int | None]] = {}  # roc.toml's [package.NAME] lines
+
+    def from_configuration(self, args: argparse.Namespace, dest: str) -> bool:
+        """Whether ``args.<dest>`` is the configured value (not given on the command line)."""
+        return dest in self.applied and getattr(args, dest, None) is self.applied[dest]
 
     def add_layer(self, values: dict, source: str, path: Path, table: str, text: str | None) -> None:
         layer = {}
@@ -78,6 +88,23 @@ class Configuration:
         for layer in self.layers:
             merged.update(layer)
         return merged
+
+
+def _closest(word: str, candidates) -> str:
+    """``did you mean 'X'? `` for the closest of ``candidates``, else nothing."""
+    import difflib
+
+    close = difflib.get_close_matches(word, list(candidates), n=1, cutoff=0.6)
+    return f"did you mean '{close[0]}'? " if close else ""
+
+
+def check_package_tables(config: Configuration, names: set[str]) -> None:
+    """Every ``[package.NAME]`` of roc.toml names a package of the workspace (a misspelled table would
+    otherwise be ignored without a word)."""
+    for name, (path, line) in config.package_tables.items():
+        if name not in names:
+            raise ConfigError(path, f"[package.{name}]", f"no package named '{name}' in the workspace; "
+                              f"{_closest(name, names)}see 'roc work list -n'", line)
 
 
 def _dest(key: str) -> str:
@@ -131,7 +158,7 @@ def meta_files(root: Path, metas: list[str] | None, ignore_user_meta: bool) -> l
 
 def load_configuration(root: Path, verb: str, profile: str | None, metas: list[str] | None = None,
                        ignore_user_meta: bool = False) -> Configuration:
-    config = Configuration()
+    config = Configuration(root)
     _load_colcon_defaults(config, root, verb)
     for path in meta_files(root, metas, ignore_user_meta):
         _load_colcon_meta(config, path)
@@ -209,12 +236,18 @@ def _load_roc_toml(config: Configuration, path: Path, verb: str, profile: str | 
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
-        match = re.search(r"line (\d+)", str(error))
-        raise ConfigError(path, "(syntax)", f"invalid TOML: {error}", int(match.group(1)) if match else None) from None
+        match = re.search(r"(.*) \(at line (\d+), column (\d+)\)", str(error))
+        if match:
+            raise UsageError(f"{path}:{match[2]}:{match[3]}: invalid TOML: {match[1]}") from None
+        if "at end of document" in str(error):
+            lines = text.splitlines() or [""]
+            raise UsageError(f"{path}:{len(lines)}:{len(lines[-1]) + 1}: invalid TOML: "
+                             f"{str(error).split(' (at ')[0]} (at the end of the file)") from None
+        raise UsageError(f"{path}: invalid TOML: {error}") from None
     known_tables = {"defaults", "profile", "package", *VERBS}
     for table, values in data.items():
         if table not in known_tables or not isinstance(values, dict):
-            raise ConfigError(path, table, f"unknown table; use [defaults], [{'], ['.join(VERBS)}], "
+            raise ConfigError(path, table, f"unknown table; {_closest(table, known_tables)}use [defaults], [{'], ['.join(VERBS)}], "
                                            "[profile.NAME], [package.NAME]", _line_of(text, table, table) or
                               next((n for n, line in enumerate(text.splitlines(), 1) if f"[{table}" in line), None))
     config.add_layer(data.get("defaults", {}), f"{ROC_TOML} [defaults]", path, "defaults", text)
@@ -239,11 +272,15 @@ def _load_roc_toml(config: Configuration, path: Path, verb: str, profile: str | 
                          f"profile.{profile}.{verb}", text)
     for name, settings in data.get("package", {}).items():
         table = f"package.{name}"
+        config.package_tables[name] = (path, next((n for n, line in enumerate(text.splitlines(), 1)
+                                                   if line.strip().replace('"', "").replace(" ", "")
+                                                   .startswith(f"[{table}]")), None))
         package = config.packages.setdefault(name, {})
         for key, value in settings.items():
             setting = Setting(value, f"{ROC_TOML} [{table}]", path, table, key, _line_of(text, table, key))
             if key not in PACKAGE_KEYS:
-                raise ConfigError(path, key, f"unknown package setting; use {', '.join(PACKAGE_KEYS)}", setting.line)
+                raise ConfigError(path, key, f"unknown package setting; {_closest(key, PACKAGE_KEYS)}"
+                                             f"use {', '.join(PACKAGE_KEYS)}", setting.line)
             _check_package_setting(setting)
             package[key] = setting
 
@@ -255,10 +292,14 @@ def apply_configuration(parser: argparse.ArgumentParser, config: Configuration) 
     for key, setting in config.effective().items():
         action = actions.get(_dest(key))
         if action is None or action.dest in ("help", "profile"):
-            options = sorted(o for a in actions.values() for o in a.option_strings
+            options = sorted(o[2:] for a in actions.values() for o in a.option_strings
                              if o.startswith("--") and o not in ("--help", "--profile"))
-            raise ConfigError(setting.path, key, f"not an option of this verb; options: {' '.join(options)}",
-                              setting.line)
+            raise ConfigError(setting.path, key, f"not an option of this verb; {_closest(key, options)}"
+                              f"options: {' '.join(options)}", setting.line)
         applied[action.dest] = setting
-        parser.set_defaults(**{action.dest: _check_type(setting, action)})
+        value = _check_type(setting, action)
+        if action.dest in DIRECTORY_OPTIONS and setting.path.parent == config.root:
+            value = str(setting.path.parent / value)  # relative to roc.toml's directory, wherever roc runs
+        config.applied[action.dest] = value
+        parser.set_defaults(**{action.dest: value})
     return applied

@@ -97,7 +97,7 @@ def test_positional_names_mean_up_to(ws):
 
 def test_env_prints_and_runs_the_build_environment(ws):
     assert roc("work", "build", cwd=ws).returncode == 0
-    printed = roc("work", "env", "alpha", cwd=ws)
+    printed = roc("work", "env", "alpha", "--all", cwd=ws)
     assert printed.returncode == 0 and "export AMENT_PREFIX_PATH=" in printed.stdout
     ran = roc("work", "env", "alpha", "--", "sh", "-c", "echo $AMENT_PREFIX_PATH", cwd=ws / "src" / "alpha")
     assert ran.returncode == 0 and ran.stdout.strip() and "using workspace root" in ran.stderr

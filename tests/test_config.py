@@ -89,8 +89,8 @@ def test_colcon_defaults_files(ws, tmp_path):
 @pytest.mark.parametrize("verb, text, line, words", [
     ("build", "[build]\nparallel-workers = \"two\"\n", 2, ["'parallel-workers'", "whole number"]),
     ("list", "[list]\n\nbogus = 1\n", 3, ["'bogus'", "not an option"]),
-    ("graph", "[biuld]\nx = 1\n", 1, ["'biuld'", "unknown table"]),
-    ("build", "[build\n", 1, ["invalid TOML"]),
+    ("graph", "[biuld]\nx = 1\n", 1, ["'biuld'", "unknown table; did you mean 'build'?"]),
+    ("build", "[build\n", "1:7", ["invalid TOML"]),
     ("build", "[package.alpha]\ncolour = \"red\"\n", 2, ["'colour'", "unknown package setting"]),
     ("build", "[build]\ncmake-args = \"-DX=1\"\n", 2, ["'cmake-args'", "list of strings"]),
 ])

@@ -31,7 +31,7 @@ from catkin_pkg.package import parse_package
 MAINTAINER = ("--maintainer-name", "Ada Lovelace", "--maintainer-email", "ada@example.com")
 OPTIONS = ("--build-type", "--dependencies", "--node-name", "--library-name", "--license", "--maintainer-name",
            "--maintainer-email", "--description", "--package-format", "--destination-directory", "--interfaces",
-           "--tests")
+           "--tests", "--parents")
 LICENSES = {  # SPDX id -> (a line of the real text, its minimum length)
     "Apache-2.0": ("Version 2.0, January 2004", 11000),
     "BSD-2-Clause": ("Redistributions in binary form must reproduce the above copyright notice,", 1200),
@@ -413,7 +413,7 @@ def test_destination_defaults_to_the_workspace_src(tmp_path):
     outside.mkdir()
     created(outside, "here")
     assert (outside / "here" / "package.xml").is_file()
-    created(outside, "there", "--destination-directory", "new/dir")
+    created(outside, "there", "--destination-directory", "new/dir", "--parents")
     assert (outside / "new" / "dir" / "there" / "package.xml").is_file()
 
 

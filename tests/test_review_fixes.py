@@ -127,7 +127,7 @@ def test_env_output_can_be_evaluated_with_exported_functions(tmp_path):
     _plain(tmp_path, "alpha")
     assert roc("work", "build", cwd=tmp_path).returncode == 0
     env = {**ros_env(), "BASH_FUNC_f%%": "() {  :\n}"}
-    printed = roc("work", "env", "alpha", cwd=tmp_path, env=env)
+    printed = roc("work", "env", "alpha", "--all", cwd=tmp_path, env=env)
     assert printed.returncode == 0 and "BASH_FUNC" not in printed.stdout
     evaluated = subprocess.run(["bash", "-c", 'eval "$1" && echo ok', "_", printed.stdout], capture_output=True,
                                text=True)

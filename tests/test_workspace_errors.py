@@ -66,7 +66,7 @@ def test_unknown_package_is_a_usage_error_with_a_hint(tmp_path: Path) -> None:
     assert close.returncode == 2
     line = assert_one_error_line(close.stderr)
     assert "--packages-up-to: no package named 'lib_c' in the workspace; did you mean " in line
-    assert line.endswith("?") and "lib_a" in line and "lib_b" in line
+    assert line.endswith("? (see 'roc work list --help')") and "lib_a" in line and "lib_b" in line
     far = run_roc("work", "graph", "--packages-above", "zzz", cwd=workspace)
     assert far.returncode == 2
     assert "run 'roc work list -n' to see the package names" in assert_one_error_line(far.stderr)
@@ -75,7 +75,6 @@ def test_unknown_package_is_a_usage_error_with_a_hint(tmp_path: Path) -> None:
 @pytest.mark.parametrize("arguments, message", [
     (["--packages-above-depth", "x", "core"], "--packages-above-depth: the first value must be a depth"),
     (["--packages-select-regex", "("], "--packages-select-regex: invalid pattern '('"),
-    (["--paths", "src/missing"], "--paths: 'src/missing' is not a directory"),
     (["--base-paths", "nowhere"], "--base-paths: 'nowhere' is not a directory"),
     (["--packages-start", "tool", "--packages-end", "core"], "comes before --packages-start 'tool'"),
     (["--no-such-option"], "unrecognized arguments: --no-such-option"),

@@ -44,15 +44,20 @@ def _links_outside(prefix: Path) -> bool:
 
 
 def export_cache(destination: Path, root: Path, build_base: Path, install_base: Path,
-                 packages: list[Package]) -> list[str]:
-    """Store every given package that is up to date (not symlink-installed ones); returns the names stored."""
+                 packages: list[Package], fingerprints: dict[str, str | None]) -> tuple[list[str], dict[str, str]]:
+    """Store every given package whose last successful build matches its fingerprint now
+    (``fingerprints``); returns the names stored, and for each other given package why it was not
+    (never stored: packages that import could not restore, or that the next build would rebuild)."""
     objects = destination / "objects"
     objects.mkdir(parents=True, exist_ok=True)
     entries = {}
+    left_out: dict[str, str] = {}
     for package in packages:
         build_dir, prefix = build_base / package.name, install_base / package.name
         fingerprint = read_state(build_dir).get("fingerprint")
-        if not fingerprint or not install_intact(prefix, package.name, build_dir) or _links_outside(prefix):
+        reason = _not_exportable(package.name, fingerprint, fingerprints.get(package.name), prefix, build_dir)
+        if reason:
+            left_out[package.name] = reason
             continue
         archive = objects / f"{fingerprint}.tar.gz"
         if not archive.exists():
@@ -67,7 +72,38 @@ def export_cache(destination: Path, root: Path, build_base: Path, install_base: 
     index = {"roc": __version__, "workspace": str(root), "install_base": str(install_base),
              "build_base": str(build_base), "packages": entries}
     write_text_atomic(destination / INDEX, json.dumps(index, indent=1, sort_keys=True))
-    return sorted(entries)
+    return sorted(entries), left_out
+
+
+def _not_exportable(name: str, stored: str | None, now: str | None, prefix: Path, build_dir: Path) -> str | None:
+    """Why a package is not exported (None: it is)."""
+    if not stored:
+        return "not built successfully yet"
+    if now != stored:
+        return "not up to date (it changed since its last build; build it first)"
+    if not install_intact(prefix, name, build_dir):
+        return "its install prefix is incomplete (build it again)"
+    if _links_outside(prefix):
+        return "installed with --symlink-install: its files point into the sources"
+    return None
+
+
+def path_dependent_file(tree: Path, paths: list[Path]) -> str | None:
+    """The first file below ``tree`` that holds one of ``paths`` where import cannot rewrite it (such a
+    package can only be restored into a workspace at the same place)."""
+    pattern = re.compile(b"|".join(re.escape(str(p).encode()) for p in paths))
+    for path in sorted(p for p in tree.rglob("*") if p.is_file() and not p.is_symlink() and p.suffix != ".pyc"):
+        data = path.read_bytes()
+        if pattern.search(data) and _keeps_path(path, data):
+            return str(path.relative_to(tree))
+    return None
+
+
+def _keeps_path(path: Path, data: bytes) -> bool:
+    """Whether an old path in this file stays after import (it is neither regenerated nor rewritten)."""
+    if path.name in REGENERATED or (path.parent.name == "hook" and path.suffix == ".sh"):
+        return False  # written again by finish_package
+    return not (_is_text(data) and (path.name in REWRITABLE or path.parent.name in REWRITABLE_DIRS))
 
 
 def _is_text(data: bytes) -> bool:
@@ -86,12 +122,10 @@ def _relocate(tree: Path, replacements: dict[bytes, bytes]) -> str | None:
         data = path.read_bytes()
         if not pattern.search(data):
             continue
-        if path.name in REGENERATED or (path.parent.name == "hook" and path.suffix == ".sh"):
-            continue  # written again by finish_package
-        if _is_text(data) and (path.name in REWRITABLE or path.parent.name in REWRITABLE_DIRS):
+        if _keeps_path(path, data):
+            return str(path.relative_to(tree))
+        if path.name not in REGENERATED and not (path.parent.name == "hook" and path.suffix == ".sh"):
             path.write_bytes(pattern.sub(lambda match: replacements[match.group(0)], data))
-            continue
-        return str(path.relative_to(tree))
     return None
 
 

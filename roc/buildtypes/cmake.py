@@ -1,7 +1,8 @@
 """cmake and ament_cmake packages: configure when needed, build, install.
 
 Configure runs only when there is no CMake cache, the arguments changed (``cmake_args.last``, as
-colcon keeps it) or it is forced. Makefile builds take part in roc's global jobserver.
+colcon keeps it) or it is forced. Switching ``--symlink-install`` on or off cleans what the other mode
+left (see ``switch_install_mode``). Makefile builds take part in roc's global jobserver.
 """
 
 from __future__ import annotations
@@ -33,6 +34,55 @@ def _cache_value(build_dir: Path, key: str) -> str | None:
     return match.group(1) if match else None
 
 
+# The files a CMake install wrote: CMake's own list, and ament_cmake's list of the symlinks it made.
+INSTALL_MANIFESTS = ("install_manifest.txt", "symlink_install_manifest.txt")
+
+
+def switch_install_mode(build_dir: Path, prefix: Path, symlink_install: bool) -> None:
+    """``--symlink-install`` switched on or off since the last configure of an ament_cmake package:
+    remove what the last install wrote (CMake would keep an installed symlink that points at its
+    source file, and ament_cmake cannot put a symlink where a directory was installed) and the CMake
+    cache (which would keep ``AMENT_CMAKE_SYMLINK_INSTALL``), so the package configures and installs
+    afresh in the new mode. ament_cmake_python's copies of (or symlinks to) Python packages in the
+    build directory that do not fit the mode go too, also after a switch that failed half-way (a copy
+    made over a symlink would write into the sources)."""
+    cached = _cache_value(build_dir, "AMENT_CMAKE_SYMLINK_INSTALL")
+    if cached is not None and (cached.upper() in ("1", "ON", "TRUE", "YES")) != symlink_install:
+        for name in INSTALL_MANIFESTS:
+            manifest = build_dir / name
+            if manifest.is_file():
+                for line in manifest.read_text().splitlines():
+                    _remove_installed(Path(line.strip()), prefix)
+                manifest.unlink()
+        (build_dir / "CMakeCache.txt").unlink()
+    for item in (build_dir / "ament_cmake_python").glob("*/*"):
+        if item.name != "setup.py" and not item.name.endswith(".egg-info") and item.is_symlink() != symlink_install:
+            _remove_tree(item)
+
+
+def _remove_tree(path: Path) -> None:
+    """Remove a file, symlink or directory tree (a symlink itself, never what it points to)."""
+    if path.is_symlink() or path.is_file():
+        path.unlink()
+    elif path.is_dir():
+        shutil.rmtree(path)
+
+
+def _remove_installed(path: Path, prefix: Path) -> None:
+    """Remove an installed file or symlink, then its parent directories inside ``prefix`` that are
+    left empty (never anything outside the prefix)."""
+    if not path.is_absolute() or prefix not in path.parents:
+        return
+    _remove_tree(path)
+    parent = path.parent
+    while parent != prefix and prefix in parent.parents:
+        try:
+            parent.rmdir()
+        except OSError:  # not empty (or already gone): stop
+            break
+        parent = parent.parent
+
+
 def _has_target(build_dir: Path, target: str) -> bool:
     """Whether the generated build system has ``target`` (Makefile or Ninja)."""
     makefile = build_dir / "Makefile"
@@ -57,6 +107,8 @@ def build_cmake(context: TaskContext, job: PackageJob, options: BuildOptions) ->
     recorded = repr(args) if args else "None"
     if options.cmake_clean_cache:
         (build_dir / "CMakeCache.txt").unlink(missing_ok=True)
+    if job.package.build_type == "ament_cmake":
+        switch_install_mode(build_dir, job.prefix, options.symlink_install)
     needs_configure = (
         options.cmake_force_configure
         or not (build_dir / "CMakeCache.txt").exists()

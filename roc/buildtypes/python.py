@@ -42,6 +42,8 @@ def build_python(context: TaskContext, job: PackageJob, options: BuildOptions) -
     lib.mkdir(parents=True, exist_ok=True)
     job.env["PYTHONPATH"] = os.pathsep.join(p for p in (str(lib), job.env.get("PYTHONPATH", "")) if p)
     record = job.build_dir / "install.log"
+    if not options.symlink_install:
+        unlink_symlinks(record)
     command = [
         # setuptools' deprecation notices of these commands, silenced as colcon silences them
         sys.executable, "-W", "ignore:setup.py install is deprecated", "-W", "ignore:easy_install command is deprecated",
@@ -57,6 +59,15 @@ def build_python(context: TaskContext, job: PackageJob, options: BuildOptions) -
         raise TaskError("setup.py install failed")
     if options.symlink_install:
         link_to_sources(job.source, record)
+
+
+def unlink_symlinks(record: Path) -> None:
+    """Remove the symlinks a ``--symlink-install`` build left in place of installed files: setup.py
+    would leave them (it copies through them onto the source file itself)."""
+    if record.is_file():
+        for line in record.read_text().splitlines():
+            if line and Path(line).is_symlink():
+                Path(line).unlink()
 
 
 def _digest(path: Path) -> str:

@@ -32,13 +32,55 @@ COMMANDS = (
 CONFIGURED_VERBS = ("list", "info", "graph", "build", "env", "cache")
 
 
+# colcon options (from extensions roc does not replace) that roc does not have, and what to do instead.
+COLCON_ONLY_OPTIONS = {
+    "--mixin": "colcon-mixin; put the arguments in a [profile.NAME] of roc.toml and use --profile NAME",
+    "--mixin-files": "colcon-mixin; put the arguments in a [profile.NAME] of roc.toml and use --profile NAME",
+    "--packages-select-test-failures": "colcon-test-result; roc has no test verb yet",
+    "--packages-skip-test-passed": "colcon-test-result; roc has no test verb yet",
+    "--log-level": "colcon's logging; use --debug for tracebacks and the log/ directory for build logs",
+}
+
+
 class Parser(argparse.ArgumentParser):
-    """argparse with roc's one-line usage errors; ``leaves`` maps each command path to its parser."""
+    """argparse with roc's one-line usage errors (``roc: error: ... (see 'roc work build --help')``) and
+    no abbreviated options (``--symlink-instal`` is an error, not ``--symlink-install``); ``leaves``
+    maps each command path to its parser."""
 
     leaves: dict[tuple[str, ...], "Parser"]
 
+    def __init__(self, *args, **kwargs) -> None:
+        kwargs["allow_abbrev"] = False
+        super().__init__(*args, **kwargs)
+
     def error(self, message: str):  # type: ignore[override]
-        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+        self.exit(EXIT_USAGE, f"roc: error: {message} (see '{self.prog} --help')\n")
+
+    def parse_args(self, args=None, namespace=None):  # type: ignore[override]
+        """Unknown arguments are reported by the parser of the command they were given to."""
+        namespace, extras = self.parse_known_args(args, namespace)
+        if extras:
+            leaf = getattr(self, "leaves", {}).get(requested_command(list(args or [])), self)
+            leaf.error(_unrecognized(leaf, extras))
+        return namespace
+
+
+def _unrecognized(parser: argparse.ArgumentParser, extras: list[str]) -> str:
+    """The message for arguments ``parser`` does not know: colcon options roc lacks by name, and the
+    closest option for a misspelled one."""
+    import difflib
+
+    for word in extras:
+        option = word.split("=", 1)[0]
+        if option in COLCON_ONLY_OPTIONS:
+            return f"roc does not support {option} ({COLCON_ONLY_OPTIONS[option]})"
+    message = f"unrecognized arguments: {' '.join(extras)}"
+    known = [o for a in parser._actions for o in a.option_strings]
+    for word in extras:
+        close = difflib.get_close_matches(word.split("=", 1)[0], known, n=1) if word.startswith("--") else []
+        if close:
+            return f"{message}; did you mean {close[0]}?"
+    return message
 
 
 def requested_command(argv: list[str]) -> tuple[str, ...]:

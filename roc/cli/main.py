@@ -18,7 +18,7 @@ from roc.cli.commands import (
     command_module,
     requested_command,
 )
-from roc.errors import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_USAGE, RocError
+from roc.errors import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_USAGE, RocError, UsageError
 
 
 def _early_value(argv: list[str], option: str) -> str | None:
@@ -57,8 +57,18 @@ def _apply_workspace_configuration(parser: Parser, path: tuple[str, ...], argv: 
     return config
 
 
+def _with_help_pointer(error: RocError, path: tuple[str, ...]) -> str:
+    """A usage error points at the help of the command it was given to, unless it already says where
+    to look (as argparse's errors do, see Parser.error)."""
+    message = str(error)
+    if isinstance(error, UsageError) and path and "see '" not in message:
+        message += f" (see '{' '.join(('roc', *path))} --help')"
+    return message
+
+
 def main(argv: list[str] | None = None) -> int:
     debug = os.environ.get("ROC_DEBUG") == "1" or "--debug" in (argv if argv is not None else sys.argv[1:])
+    path: tuple[str, ...] = ()
     try:
         argv = list(sys.argv[1:] if argv is None else argv)
         first_word = next((i for i, w in enumerate(argv) if not w.startswith("-") and (i == 0 or argv[i - 1] != "-C")),
@@ -89,7 +99,7 @@ def main(argv: list[str] | None = None) -> int:
     except RocError as error:
         if debug:
             raise
-        print(f"roc: error: {error}", file=sys.stderr)
+        print(f"roc: error: {_with_help_pointer(error, path)}", file=sys.stderr)
         return error.exit_code
     except KeyboardInterrupt:
         print("roc: interrupted", file=sys.stderr)
@@ -107,5 +117,6 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as error:  # noqa: BLE001 - last resort: one line, details with --debug
         if debug:
             raise
-        print(f"roc: internal error: {type(error).__name__}: {error} (run with --debug for details)", file=sys.stderr)
+        print(f"roc: error: internal error: {type(error).__name__}: {error} (run with --debug for details)",
+              file=sys.stderr)
         return EXIT_FAILURE

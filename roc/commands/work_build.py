@@ -33,10 +33,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="packages built at once, 0 for no limit (default: the number of CPUs)")
     add("-j", "--jobs", type=int, metavar="N",
         help="compiler jobs of all packages together (default: -j of MAKEFLAGS, else the number of CPUs)")
-    add("--event-handlers", nargs="*", metavar="NAME+/-", default=[],
-        help="enable (+) or disable (-) output: console_start_end, console_stderr, console_direct, "
-             "console_cohesion, summary, status, log, event_log, store_result")
+    handlers = add("--event-handlers", nargs="*", metavar="NAME+/-", default=[],
+                   help="enable (+) or disable (-) output: console_start_end, console_stderr, console_direct, "
+                        "console_cohesion, summary, status, log, event_log, store_result")
+    handlers.completion = [f"{name}{sign}" for name in sorted(EVENT_HANDLERS) for sign in "+-"]
     add("--output", choices=("text", "json"), default="text", help="json: one JSON event per line on stdout")
+    add("--allow-overriding", action="extend", nargs="+", default=[], metavar="PKG_NAME",
+        help="build these packages without the warning that an underlay workspace has them too")
     add("--force", action="store_true", help="rebuild the selected packages even when they are up to date")
     add("--no-cache", action="store_true",
         help="neither skip up-to-date packages nor record fingerprints for the next build")
@@ -90,6 +93,19 @@ def skip_configured_packages(args: argparse.Namespace, workspace) -> None:
         workspace.selected -= {name for name, skip in config.package_values("skip").items() if skip}
 
 
+def warn_about_overrides(args: argparse.Namespace, workspace, install_base: Path) -> None:
+    """colcon-override-check's warning: a selected package shadows one that underlay packages use."""
+    from roc.messages import warn
+    from roc.workspace.underlay import override_warning, overridden_packages
+
+    for name in args.allow_overriding:
+        if name not in workspace.by_name:
+            warn(f"--allow-overriding: ignoring unknown package '{name}'")
+    overridden = overridden_packages(workspace.selected, install_base, args.allow_overriding, os.environ)
+    if overridden:
+        warn(override_warning(overridden))
+
+
 def _event_handler_switches(values: list[str]) -> dict[str, bool]:
     switches: dict[str, bool] = {}
     for value in values:
@@ -139,6 +155,7 @@ def run(args: argparse.Namespace) -> int:
         force=args.force,
         use_state=not args.no_cache,
     )
+    warn_about_overrides(args, workspace, options.install_base)
     with build_lock(options.build_base):
         prepare_build_base(options.build_base)
         prepare_install_base(options.install_base, args.merge_install)

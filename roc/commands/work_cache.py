@@ -25,7 +25,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from roc.builder.cache_store import check_isolated, export_cache, import_cache
+    from roc.builder.cache_store import (
+        check_isolated,
+        export_cache,
+        import_cache,
+        path_dependent_file,
+    )
     from roc.builder.uptodate import fingerprint_packages
     from roc.errors import UsageError
     from roc.workspace.load import load_workspace
@@ -34,17 +39,26 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"roc work cache {args.action} needs the cache directory: roc work cache {args.action} PATH")
     workspace = load_workspace(args)
     options = build_options(args, workspace.root)
-    if args.action == "key":
+    if args.action in ("key", "export"):
         states = fingerprint_packages(workspace, options)
+    if args.action == "key":
         data = json.dumps({name: state.fingerprint for name, state in sorted(states.items())})
         print(f"roc-{hashlib.sha256(data.encode()).hexdigest()[:40]}")
         return 0
     check_isolated(options.merge_install)
     cache = Path(args.path).absolute()
     if args.action == "export":
-        stored = export_cache(cache, workspace.root, options.build_base, options.install_base,
-                              workspace.selected_in_order())
+        stored, left_out = export_cache(cache, workspace.root, options.build_base, options.install_base,
+                                        workspace.selected_in_order(),
+                                        {name: state.fingerprint for name, state in states.items()})
         print(f"exported {len(stored)} up-to-date package(s) to {cache}")
+        for name in stored:
+            fixed = path_dependent_file(options.install_base / name, [workspace.root, options.install_base])
+            if fixed:
+                print(f"  {name}: import can restore it only into {workspace.root} ({fixed} holds that path)",
+                      file=sys.stderr)
+        for name, why in sorted(left_out.items()):
+            print(f"  not exported: {name}: {why}", file=sys.stderr)
         return 0
     from roc.builder.layout import (
         prepare_build_base,

@@ -8,6 +8,8 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from roc.errors import RocError, UsageError
+
 if TYPE_CHECKING:
     from roc.create.spec import PackageSpec
 
@@ -39,6 +41,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--destination-directory", metavar="DIR",
                         help="where the package directory goes (default: the workspace's src/ inside a "
                              "workspace, else the current directory)")
+    parser.add_argument("--parents", action="store_true",
+                        help="roc: create the missing parent directories of --destination-directory")
     parser.add_argument("--interfaces", action="store_true",
                         help="roc: an interface package (example msg, srv and action; ament_cmake with rosidl)")
     parser.add_argument("--tests", action="store_true",
@@ -53,7 +57,8 @@ def run(args: argparse.Namespace) -> int:
         print("\n".join(licenses.KNOWN))
         return 0
     spec, notes = _spec(args)
-    destination = _destination(args.destination_directory)
+    destination = _destination(args.destination_directory, args.parents)
+    _check_name_is_free(spec.name, destination)
 
     from roc.create.render import render_package
     from roc.create.write import write_package
@@ -94,13 +99,35 @@ def _spec(args: argparse.Namespace) -> tuple[PackageSpec, list[str]]:
     return spec, notes
 
 
-def _destination(option: str | None) -> Path:
+def _destination(option: str | None, parents: bool) -> Path:
     if option is not None:
-        return Path(option).absolute()
+        destination = Path(option).absolute()
+        if not parents and not destination.parent.is_dir():
+            raise UsageError(f"--destination-directory {option}: {destination.parent} does not exist; "
+                             "create it, or add --parents to create the missing directories")
+        return destination
     from roc.workspace.root import find_workspace_root
 
     root = find_workspace_root(Path.cwd())
     return root / "src" if root is not None else Path.cwd()
+
+
+def _check_name_is_free(name: str, destination: Path) -> None:
+    """A workspace cannot hold two packages of one name: refuse before writing anything."""
+    from roc.workspace.load import discover_workspace
+    from roc.workspace.root import find_workspace_root
+
+    root = find_workspace_root(destination)
+    if root is None:
+        return
+    try:
+        packages = discover_workspace(root)
+    except RocError:  # a workspace that cannot be read (a broken package.xml) is no reason not to create
+        return
+    same = next((p for p in packages if p.name == name), None)
+    if same is not None:
+        raise UsageError(f"the workspace {root} already has a package named '{name}' (in {root / same.path}); "
+                         "choose another name")
 
 
 def _shown(path: Path) -> str:

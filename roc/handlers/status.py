@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import re
 import time
+from collections.abc import Callable
 
 from roc.engine.events import (
     Event,
@@ -37,16 +38,24 @@ def progress_of(data: bytes) -> int | None:
 
 
 class StatusLine:
-    """Keeps a rich Live line under the normal output; ``print`` writes above it."""
+    """Keeps a rich Live line under the normal output; ``print`` writes above it.
 
-    def __init__(self) -> None:
+    The line is redrawn only when its text changes, and at most every ``MIN_INTERVAL`` seconds (a build
+    sends hundreds of output events; redrawing for each costs terminal bandwidth and flickers)."""
+
+    MIN_INTERVAL = 0.25
+
+    def __init__(self, console=None, live=None, clock: Callable[[], float] = time.monotonic) -> None:
         from rich.console import Console
         from rich.live import Live
 
-        self.console = Console(highlight=False)
-        self.live = Live(console=self.console, auto_refresh=False, transient=True)
+        self.console = console or Console(highlight=False)
+        self.live = live or Live(console=self.console, auto_refresh=False, transient=True)
         self.live.start()
-        self.started = time.monotonic()
+        self.clock = clock
+        self.started = clock()
+        self.drawn_text: str | None = None
+        self.drawn_at = float("-inf")
         self.total = 0
         self.done = 0
         self.running: dict[str, int | None] = {}
@@ -74,8 +83,13 @@ class StatusLine:
     def _refresh(self) -> None:
         from rich.text import Text
 
-        elapsed = time.monotonic() - self.started
+        now = self.clock()
+        if now - self.drawn_at < self.MIN_INTERVAL:
+            return
         running = " ".join(f"{name}{f' {p}%' if p is not None else ''}" for name, p in self.running.items())
-        line = f"[{elapsed:.1f}s] [{self.done}/{self.total} done] [{len(self.running)} running] {running}"
-        width = self.console.width or 80
-        self.live.update(Text(line[: width - 1], style="bold"), refresh=True)
+        line = f"[{int(now - self.started)}s] [{self.done}/{self.total} done] [{len(self.running)} running] {running}"
+        line = line[: (self.console.width or 80) - 1]
+        if line == self.drawn_text:
+            return
+        self.drawn_text, self.drawn_at = line, now
+        self.live.update(Text(line, style="bold"), refresh=True)

@@ -2,7 +2,8 @@
 
 ``--base-paths`` are crawled recursively (default ``.``): the crawl stops at a package, skips hidden
 directories, follows symlinks once (by real path) and prunes ignored directories. ``--paths`` name
-package directories directly (shell wildcards allowed). Either replaces the default base path.
+package directories directly (shell wildcards allowed; entries that are not directories are ignored,
+as in colcon). Either replaces the default base path.
 """
 
 from __future__ import annotations
@@ -53,8 +54,8 @@ def discover_packages(
         _crawl(start, Path(base), variables, found, visited)
     for given in _expand(paths or [], root):
         directory = root / given
-        if not directory.is_dir():
-            raise UsageError(f"--paths: '{given}' is not a directory")
+        if not directory.is_dir():  # e.g. files of a shell-expanded 'src/repo/*': colcon ignores them
+            continue
         real = os.path.realpath(directory)
         visited.append(str(directory))
         if real in found:

@@ -34,10 +34,13 @@ class Workspace:
 
 
 def resolve_root(args: argparse.Namespace) -> Path:
-    """Explicit --base-paths/--paths are taken from the current directory, as colcon does; otherwise
-    roc looks upward for the workspace root and says so when it is not the current directory."""
-    if args.base_paths is not None or args.paths is not None:
-        return Path.cwd()
+    """--base-paths/--paths given on the command line are taken from the current directory, as colcon
+    does; otherwise (also when roc.toml sets them) roc looks upward for the workspace root and says so
+    when it is not the current directory."""
+    config = getattr(args, "configuration", None)
+    for dest in ("base_paths", "paths"):
+        if getattr(args, dest) is not None and not (config and config.from_configuration(args, dest)):
+            return Path.cwd()
     return find_workspace_root_for(args)
 
 
@@ -50,17 +53,29 @@ def find_workspace_root_for(args: argparse.Namespace) -> Path:
     return root
 
 
-def load_workspace(args: argparse.Namespace) -> Workspace:
-    root = resolve_root(args)
+def discover_workspace(root: Path, base_paths: list[str] | None = None,
+                       paths: list[str] | None = None) -> list[Package]:
+    """The packages of the workspace at ``root`` (from the discovery cache when nothing changed)."""
     variables = condition_environment(os.environ)
 
     def discover(visited: list[str]) -> list[Package]:
         from roc.workspace.discovery import discover_packages
 
-        return discover_packages(root, variables, args.base_paths, args.paths, visited)
+        return discover_packages(root, variables, base_paths, paths, visited)
 
-    packages = cached_discovery(root, variables, args.base_paths, args.paths, discover)
-    check_selection_arguments(args, {p.name for p in packages})
+    return cached_discovery(root, variables, base_paths, paths, discover)
+
+
+def load_workspace(args: argparse.Namespace) -> Workspace:
+    root = resolve_root(args)
+    packages = discover_workspace(root, args.base_paths, args.paths)
+    names = {p.name for p in packages}
+    config = getattr(args, "configuration", None)
+    if config is not None:
+        from roc.config import check_package_tables
+
+        check_package_tables(config, names)
+    check_selection_arguments(args, names)
     ordered = topological_order(ignore_packages(args, packages))
     build_base = root / getattr(args, "build_base", "build")
     return Workspace(root=root, ordered=ordered, selected=select_packages(args, ordered, build_base))
