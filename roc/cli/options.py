@@ -111,6 +111,6 @@ def add_graph_arguments(parser: argparse.ArgumentParser) -> None:
     add_format_argument(parser)
     parser.add_argument("--no-daemon", action="store_true", help="do not use (or start) the roc daemon")
     parser.add_argument("--spin-time", type=float, metavar="SECONDS",
-                        help="without the daemon: how long to discover the graph (default: 3, one DDS "
+                        help="without the daemon: how long to discover the graph (default: 3.5, one DDS "
                              "announcement period; less may miss processes)")
     parser.add_argument("--use-sim-time", action="store_true", help=argparse.SUPPRESS)

@@ -120,10 +120,7 @@ def _start_lock(path: Path):
 
 def _usable(connection: Connection) -> bool:
     """The daemon is of this roc version and serves this discovery environment; else it is stopped."""
-    try:
-        hello = connection.request("hello", timeout=5)
-    except RocError:
-        hello = {}
+    hello = connection.request("hello", timeout=10)
     if hello.get("version") == __version__ and hello.get("environment") == discovery_environment():
         return True
     try:

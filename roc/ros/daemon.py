@@ -32,16 +32,20 @@ class Daemon:
         self.started = time.time()
 
     def serve(self) -> None:
+        # Bound and listening under a temporary name, then renamed into place: a client never finds
+        # the path refusing connections (it would take it for a dead daemon's socket and remove it).
         listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
-        self.path.unlink(missing_ok=True)
+        staging = self.path.with_name(f".{self.path.name}.{os.getpid()}")
+        staging.unlink(missing_ok=True)
         old_umask = os.umask(0o177)
         try:
-            listener.bind(str(self.path))
+            listener.bind(str(staging))
         finally:
             os.umask(old_umask)
-        os.chmod(self.path, 0o600)
-        self._inode = self.path.stat().st_ino
+        os.chmod(staging, 0o600)
         listener.listen(64)
+        os.replace(staging, self.path)
+        self._inode = self.path.stat().st_ino
         listener.settimeout(0.5)
         threading.Thread(target=self._discover, daemon=True).start()
         try:

@@ -23,12 +23,13 @@ from rclpy.signals import SignalHandlerOptions
 
 from roc.errors import RocError
 
-# Without a daemon, discovery lasts one Fast DDS announcement period (3 s: measured on localhost,
-# processes keep appearing up to 2.5 s after a fresh participant starts, with gaps of almost 2 s, so
-# no shorter quiet period is complete), then until the graph has been quiet for QUIET_SECONDS and
+# Without a daemon, discovery lasts one Fast DDS announcement period and a margin (3.5 s: measured on
+# localhost, processes keep appearing up to 3 s after a fresh participant starts, with gaps of almost
+# 2 s: a participant outside the initial peers' range is heard at its next periodic announcement,
+# so no shorter quiet period is complete), then until the graph has been quiet for QUIET_SECONDS and
 # every endpoint's node is known, at most EXTRA_SECONDS longer. ``--spin-time`` sets the period.
 QUIET_SECONDS = 0.3
-DEFAULT_SPIN_TIME = 3.0
+DEFAULT_SPIN_TIME = 3.5
 EXTRA_SECONDS = 1.0
 POLL_SECONDS = 0.05
 SERVICE_TIMEOUT = 5.0
