@@ -112,3 +112,31 @@ def test_client_does_not_import_rclpy(demo):
             "print('rclpy' in sys.modules, file=sys.stderr)")
     done = subprocess.run([sys.executable, "-c", code], env=demo, capture_output=True, text=True, timeout=60)
     assert done.stderr.strip() == "False"
+
+
+def test_qos_incompatibility_and_duplicate_names_flagged(tmp_path):
+    from graph_helpers import start_nodes, stop_all
+
+    env = graph_env(45, tmp_path)
+    processes = start_nodes([
+        [{"name": "sensor", "publishers": [{"topic": "scan", "type": "std_msgs/msg/String",
+                                            "reliability": "best_effort"}]}],
+        [{"name": "sensor", "subscribers": [{"topic": "scan", "type": "std_msgs/msg/String",
+                                             "durability": "transient_local"}]}],
+    ], env)
+    try:
+        info = roc("topic", "info", "-v", "/scan", "--no-daemon", env=env)
+        assert info.returncode == 0
+        assert info.stderr.splitlines() == [
+            "roc: warning: QoS incompatible (reliability): /sensor -> /sensor: publisher offers BEST_EFFORT, "
+            "subscriber requests RELIABLE; make the subscriber BEST_EFFORT or the publisher RELIABLE",
+            "roc: warning: QoS incompatible (durability): /sensor -> /sensor: publisher offers VOLATILE, "
+            "subscriber requests TRANSIENT_LOCAL; make the subscriber VOLATILE or the publisher TRANSIENT_LOCAL"]
+        data = json.loads(roc("topic", "info", "/scan", "--format", "json", env=env).stdout)
+        assert [p["policy"] for p in data["problems"]] == ["reliability", "durability"]
+        nodes = roc("node", "list", env=env)
+        assert nodes.stdout == "/sensor\n/sensor\n"
+        assert "several nodes are named /sensor" in nodes.stderr
+    finally:
+        stop_daemon(env)
+        stop_all(processes)
