@@ -30,11 +30,12 @@ def print_json_line(data: Any, stream: TextIO | None = None) -> None:
     out.flush()
 
 
-def to_yaml(data: Any, flow_style: bool | None = False) -> str:
-    """YAML with keys in their given order, as ros2 prints messages and parameters."""
+def to_yaml(data: Any, flow_style: bool | None = False, width: int | None = None) -> str:
+    """YAML with keys in their given order, as ros2 prints messages and parameters (``width``: the
+    line length to wrap long scalars at; ros2 never wraps messages)."""
     import yaml
 
-    return yaml.dump(data, sort_keys=False, default_flow_style=flow_style, allow_unicode=True)
+    return yaml.dump(data, sort_keys=False, default_flow_style=flow_style, allow_unicode=True, width=width)
 
 
 def print_yaml(data: Any, stream: TextIO | None = None) -> None:
