@@ -30,12 +30,28 @@ def print_json_line(data: Any, stream: TextIO | None = None) -> None:
     out.flush()
 
 
-def to_yaml(data: Any, flow_style: bool | None = False, width: int | None = None) -> str:
-    """YAML with keys in their given order, as ros2 prints messages and parameters (``width``: the
-    line length to wrap long scalars at; ros2 never wraps messages)."""
+def to_yaml(data: Any, flow_style: bool | None = False) -> str:
+    """YAML with keys in their given order, as ros2 prints messages and parameters."""
     import yaml
 
-    return yaml.dump(data, sort_keys=False, default_flow_style=flow_style, allow_unicode=True, width=width)
+    return yaml.dump(data, sort_keys=False, default_flow_style=flow_style, allow_unicode=True)
+
+
+def to_message_yaml(data: Any, flow_style: bool = False) -> str:
+    """YAML as ``ros2 topic echo`` prints a message: keys in order, no line wrapping and, with
+    ``flow_style`` (``--flow-style``), lists inline but mappings still in block style."""
+    import yaml
+
+    class MessageDumper(yaml.Dumper):
+        pass
+
+    def block_mapping(dumper: yaml.Dumper, mapping: dict) -> yaml.MappingNode:
+        items = [(dumper.represent_data(k), dumper.represent_data(v)) for k, v in mapping.items()]
+        return yaml.MappingNode("tag:yaml.org,2002:map", items)
+
+    MessageDumper.add_representer(dict, block_mapping)
+    return yaml.dump(data, Dumper=MessageDumper, default_flow_style=flow_style, allow_unicode=True,
+                     width=sys.maxsize)
 
 
 def print_yaml(data: Any, stream: TextIO | None = None) -> None:

@@ -12,8 +12,7 @@ from __future__ import annotations
 
 import array
 import math
-import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from functools import lru_cache, partial
 from typing import Any
 
@@ -22,7 +21,7 @@ import yaml
 from rosidl_parser import definition as idl
 
 from roc.errors import UsageError
-from roc.render import to_yaml
+from roc.render import to_message_yaml
 from roc.ros.types import interface_kind, resolve_type, type_name
 
 
@@ -38,7 +37,7 @@ INT_RANGES = {
 }
 TYPECODES = {"int8": "b", "uint8": "B", "char": "B", "int16": "h", "uint16": "H", "int32": "i",
              "uint32": "I", "int64": "q", "uint64": "Q", "float": "f", "double": "d"}
-FLOAT32_MAX = 3.402823466e38
+FLOAT32_MAX = float(numpy.finfo(numpy.float32).max)
 # IDL names of basic types -> the names people write in .msg files (for error messages).
 MSG_NAMES = {"boolean": "bool", "octet": "byte", "float": "float32", "double": "float64"}
 
@@ -56,7 +55,6 @@ def _field_map(cls: type) -> dict[str, Any]:
     return dict(fields(cls))
 
 
-@lru_cache(maxsize=None)
 def _nested_class(namespaced: idl.NamespacedType) -> type:
     return resolve_type("/".join(namespaced.namespaced_name()))
 
@@ -128,15 +126,23 @@ def message_to_yaml(msg: Any, *, no_arr: bool = False, no_str: bool = False,
 
 
 def dict_to_yaml(data: dict[str, Any], *, flow_style: bool = False) -> str:
-    """Message data as YAML text, with ros2's settings (no line wrapping)."""
-    return to_yaml(data, flow_style=flow_style, width=sys.maxsize)
+    """Message data as YAML text, as ros2 prints it (see render.to_message_yaml)."""
+    return to_message_yaml(data, flow_style=flow_style)
 
 
 def message_to_csv(msg: Any, *, no_arr: bool = False, no_str: bool = False,
                    truncate_length: int | None = None) -> str:
     """All fields, recursively, separated by commas, as ``ros2 topic echo --csv`` prints them."""
-    return ",".join(_csv(getattr(msg, name), slot, no_arr, no_str, truncate_length)
-                    for name, slot in fields(type(msg)))
+    return _csv_join(_csv(getattr(msg, name), slot, no_arr, no_str, truncate_length)
+                     for name, slot in fields(type(msg)))
+
+
+def _csv_join(parts: Iterable[str]) -> str:
+    """Comma-joined, as ros2 joins: no comma after a still empty line (leading empty values vanish)."""
+    line = ""
+    for part in parts:
+        line = f"{line},{part}" if line else part
+    return line
 
 
 def _csv(value: Any, slot: Any, no_arr: bool, no_str: bool, limit: int | None) -> str:
@@ -147,7 +153,7 @@ def _csv(value: Any, slot: Any, no_arr: bool, no_str: bool, limit: int | None) -
                  for item in (value if limit is None else value[:limit])]
         if limit is not None and len(value) > limit:
             parts.append("...")
-        return ",".join(parts)
+        return _csv_join(parts)
     if isinstance(value, str):
         if no_str:
             return f"<string length: <{len(value)}>>"
@@ -329,8 +335,8 @@ def _as_float(value: Any) -> float | None:
     if isinstance(value, (int, float)):
         return float(value)
     if isinstance(value, str):
-        try:
-            return float(value.strip())
+        try:  # also YAML's spellings: .nan, .inf, -.inf
+            return float(value.strip().lower().replace(".inf", "inf").replace(".nan", "nan"))
         except ValueError:
             return None
     return None
