@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import difflib
 import importlib
-import importlib.util
 import os
 from functools import lru_cache
 from pathlib import Path
@@ -54,12 +53,21 @@ def interface_kind(cls: type) -> str:
     return "msg"
 
 
-def _lookup(package: str, kind: str, name: str) -> type | None:
-    """The class ``name`` of ``package.kind``, including the parts of services and actions that
-    their modules do not export (``Fibonacci_Goal``, ``Fibonacci_FeedbackMessage``)."""
+def _interface_module(package: str, kind: str) -> Any:
+    """The generated module ``package.kind``, or None (a source directory that Python sees as a
+    namespace package does not count)."""
     try:
         module = importlib.import_module(f"{package}.{kind}")
     except ImportError:
+        return None
+    return module if getattr(module, "__file__", None) else None
+
+
+def _lookup(package: str, kind: str, name: str) -> type | None:
+    """The class ``name`` of ``package.kind``, including the parts of services and actions that
+    their modules do not export (``Fibonacci_Goal``, ``Fibonacci_FeedbackMessage``)."""
+    module = _interface_module(package, kind)
+    if module is None:
         return None
     found = getattr(module, name, None)
     if found is None and "_" in name:
@@ -118,9 +126,8 @@ def interface_packages() -> set[str]:
 
 
 def _package_types(package: str, kind: str) -> list[str]:
-    try:
-        module = importlib.import_module(f"{package}.{kind}")
-    except ImportError:
+    module = _interface_module(package, kind)
+    if module is None:
         return []
     return [n for n, v in vars(module).items() if isinstance(v, type) and "_" not in n]
 
@@ -133,7 +140,7 @@ def _did_you_mean(word: str, choices: list[str] | set[str]) -> str:
 def _unknown_message(name: str, package: str, kinds: list[str], short: str) -> str:
     nouns = " or ".join(KIND_NOUNS[k] for k in kinds)
     hint = _unsourced_hint(package, kinds, short)
-    if importlib.util.find_spec(package) is None:
+    if not any(_interface_module(package, kind) for kind in KINDS):
         guess = "" if hint else _did_you_mean(package, interface_packages())
         return f"unknown {nouns} type '{name}': no interface package '{package}' is installed{guess}" + (
             hint or "; install it or source the workspace that builds it")
