@@ -74,8 +74,9 @@ SAMPLES: dict[str, list[Any]] = {
     "float": [FLOAT32_MAX, -FLOAT32_MAX, math.inf, -math.inf, 1.5, math.nan],
     "double": [sys.float_info.max, -sys.float_info.max, 5e-324, math.nan, -math.inf, 0.1],
 }
-TEXT = ["ünïcode: 'quoted' \"both\" # not a comment", "", "line\nbreak", "- dash"]
-WIDE = ["ハローワールド ✓", "", "Hellö"]
+TEXT = ["ünïcode: 'quoted' \"both\" # not a comment", "", "line\nbreak", "- dash",
+        "emoji 😀, controls \x85 \u2028 \x07 \ttab, trailing space ", "null", "0x1F"]
+WIDE = ["ハローワールド ✓", "", "Hellö", "😀 astral"]
 
 
 def sample(slot: Any, variant: int) -> Any:
