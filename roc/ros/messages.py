@@ -165,6 +165,18 @@ def _csv(value: Any, slot: Any, no_arr: bool, no_str: bool, limit: int | None) -
     return message_to_csv(value, no_arr=no_arr, no_str=no_str, truncate_length=limit)
 
 
+def echo_text(value: Any, *, csv: bool = False, flow_style: bool = False, no_arr: bool = False,
+              no_str: bool = False, truncate_length: int | None = None) -> str:
+    """What ``ros2 topic echo`` prints for one message, or for the value ``--field`` selected:
+    YAML and a ``---`` line, one CSV line, or a plain value as Python prints it and ``---``."""
+    if not hasattr(type(value), "SLOT_TYPES"):
+        return f"{value}\n---\n"
+    if csv:
+        return message_to_csv(value, no_arr=no_arr, no_str=no_str, truncate_length=truncate_length) + "\n"
+    return message_to_yaml(value, no_arr=no_arr, no_str=no_str, truncate_length=truncate_length,
+                           flow_style=flow_style) + "---\n"
+
+
 def get_field(msg: Any, path: str) -> Any:
     """The value at a dotted field path (``pose.pose.position``), as ``echo --field`` selects it."""
     value = msg
