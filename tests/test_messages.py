@@ -166,6 +166,8 @@ def test_large_arrays_take_the_fast_path() -> None:
 
 
 def stdout_of(reference: str) -> str:
+    if not (REFERENCE / reference).is_file():
+        pytest.skip(f"no ros2 reference output at {REFERENCE / reference}")
     text = (REFERENCE / reference).read_text()
     return text.split("--- stdout ---\n", 1)[1].split("--- stderr ---\n", 1)[0]
 
