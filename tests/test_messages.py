@@ -198,6 +198,9 @@ def test_echo_field_selects_like_ros2() -> None:
     with pytest.raises(MessageValueError) as error:
         get_field(odom, "child_frame_id.x")
     assert str(error.value) == "child_frame_id.x: 'child_frame_id' is not a message"
+    with pytest.raises(MessageValueError) as error:
+        get_field(fill_message("std_msgs/msg/Empty", {}), "x")
+    assert str(error.value) == "x: std_msgs/msg/Empty has no field 'x' (it has no fields)"
 
 
 def test_flow_style_and_csv() -> None:

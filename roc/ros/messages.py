@@ -184,12 +184,13 @@ def get_field(msg: Any, path: str) -> Any:
     if not names:
         raise MessageValueError(f"invalid field '{path}': expected field names separated by dots")
     for depth, name in enumerate(names):
-        known = _field_map(type(value)) if hasattr(type(value), "SLOT_TYPES") else {}
+        where = ".".join(names[: depth + 1])
+        if not hasattr(type(value), "SLOT_TYPES"):
+            raise MessageValueError(f"{where}: '{'.'.join(names[:depth])}' is not a message")
+        known = _field_map(type(value))
         if name not in known:
-            where = ".".join(names[: depth + 1])
-            if not known:
-                raise MessageValueError(f"{where}: '{'.'.join(names[:depth]) }' is not a message")
-            raise MessageValueError(f"{where}: {type_name(value)} has no field '{name}' ({', '.join(known)})")
+            listed = ", ".join(known) or "it has no fields"
+            raise MessageValueError(f"{where}: {type_name(value)} has no field '{name}' ({listed})")
         value = getattr(value, name)
     return value
 
