@@ -360,6 +360,23 @@ def test_unknown_types(name: str, kind: str | None, message: str, monkeypatch: p
     assert str(error.value) == message
 
 
+def test_unsourced_system_install_is_pointed_at(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from roc.ros import types
+
+    share = tmp_path / "opt" / "ros" / "jazzy" / "share" / "demo_nav_msgs" / "msg"
+    share.mkdir(parents=True)
+    (share / "Goal.msg").write_text("float64 x\n")
+    monkeypatch.setattr(types, "SYSTEM_ROOTS", (tmp_path / "opt" / "ros",))
+    monkeypatch.setenv("AMENT_PREFIX_PATH", sys.prefix)
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(UnknownTypeError) as error:
+        resolve_type("demo_nav_msgs/Goal", "msg")
+    jazzy = tmp_path / "opt" / "ros" / "jazzy"
+    assert str(error.value) == (
+        "unknown message type 'demo_nav_msgs/Goal': no interface package 'demo_nav_msgs' is installed; "
+        f"it is in {jazzy}, which is not sourced: source {jazzy}/setup.bash first")
+
+
 @pytest.mark.slow
 def test_unsourced_install_is_pointed_at(tmp_path: Path) -> None:
     """A type built in the workspace but not sourced: the error says to source install/setup.bash."""

@@ -151,23 +151,32 @@ def _unknown_message(name: str, package: str, kinds: list[str], short: str) -> s
         hint or "; see 'roc interface list'")
 
 
+# System installs whose setup script may not be sourced (``/opt/ros/<distro>``).
+SYSTEM_ROOTS = (Path("/opt/ros"),)
+
+
+def _defines(prefix: Path, package: str, kinds: list[str], short: str) -> bool:
+    share = prefix / "share" / package
+    return any((share / kind / f"{short}{suffix}").is_file()
+               for kind in kinds for suffix in (DEFINITION_SUFFIXES[kind], ".idl"))
+
+
 def _unsourced_hint(package: str, kinds: list[str], short: str) -> str:
-    """``; it is in install/, which is not sourced: ...`` when the current workspace's install
-    base (isolated or merged) holds the type's definition but is not on AMENT_PREFIX_PATH."""
+    """``; it is built in install, which is not sourced: ...`` when the current workspace's install
+    base (isolated or merged), or a ``/opt/ros/<distro>``, holds the type's definition but is not on
+    AMENT_PREFIX_PATH."""
     from roc.workspace.root import find_workspace_root
 
-    root = find_workspace_root(Path.cwd())
-    if root is None or not (root / "install").is_dir():
-        return ""
-    install = root / "install"
     sourced = {p.resolve() for p in _prefixes() if p.exists()}
-    for prefix in (install / package, install):
-        share = prefix / "share" / package
-        if prefix.resolve() in sourced:
-            continue
-        for kind in kinds:
-            for suffix in (DEFINITION_SUFFIXES[kind], ".idl"):
-                if (share / kind / f"{short}{suffix}").is_file():
-                    shown = os.path.relpath(install)
-                    return f"; it is built in {shown}, which is not sourced: source {shown}/setup.bash first"
+    root = find_workspace_root(Path.cwd())
+    install = root / "install" if root else None
+    if install and install.is_dir():
+        for prefix in (install / package, install):
+            if prefix.resolve() not in sourced and _defines(prefix, package, kinds, short):
+                shown = os.path.relpath(install)
+                return f"; it is built in {shown}, which is not sourced: source {shown}/setup.bash first"
+    for system in SYSTEM_ROOTS:
+        for prefix in sorted(system.glob("*")) if system.is_dir() else []:
+            if prefix.resolve() not in sourced and _defines(prefix, package, kinds, short):
+                return f"; it is in {prefix}, which is not sourced: source {prefix}/setup.bash first"
     return ""
