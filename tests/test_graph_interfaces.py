@@ -44,11 +44,29 @@ def test_listings_same_as_ros2(env, command):
     assert key(got.stdout.splitlines()) == key(expected.stdout.splitlines())
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("options", [(), ("--no-quotes",)], ids=lambda o: " ".join(o) or "default")
+@pytest.mark.parametrize("type_name", ["geometry_msgs/msg/Twist", "std_srvs/srv/SetBool", "test_msgs/action/Fibonacci",
+                                       "nav_msgs/msg/Odometry", "visualization_msgs/msg/Marker"])
+def test_proto_same_as_ros2(env, type_name, options):
+    import sys
+    from pathlib import Path
+
+    site = Path(sys.prefix) / "lib" / f"python{sys.version_info.major}.{sys.version_info.minor}" / "site-packages"
+    oracle_env = {**env, "PYTHONPATH": str(site)}  # the oracle's venv lacks the message packages
+    got, expected = roc("interface", "proto", *options, type_name, env=env), ros2("interface", "proto", *options,
+                                                                                 type_name, env=oracle_env)
+    assert got.returncode == 0, got.stderr
+    assert got.stdout == expected.stdout
+
+
 def test_unknown_interface_is_one_line(env):
     got = roc("interface", "show", "std_msgs/msg/Nope", env=env)
     assert got.returncode == 1 and got.stderr.startswith("roc: error: Could not find the interface ")
     assert len(got.stderr.splitlines()) == 1
     assert roc("interface", "package", "nope", env=env).stderr == "roc: error: Unknown package 'nope'\n"
+    proto = roc("interface", "proto", "nope/msg/X", env=env)
+    assert proto.returncode == 1 and len(proto.stderr.splitlines()) == 1
 
 
 def test_show_json(env):

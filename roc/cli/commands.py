@@ -50,6 +50,7 @@ COMMANDS = (
     (("interface", "packages"), (), "interface_packages", "list the packages that define interfaces"),
     (("interface", "package"), (), "interface_package", "list the interfaces of one package"),
     (("interface", "show"), (), "interface_show", "print an interface definition, nested types expanded"),
+    (("interface", "proto"), (), "interface_proto", "print a YAML prototype of a message, request or goal"),
     (("daemon",), (), None, "the roc daemon (a warm graph participant): start, stop, status"),
     (("daemon", "start"), (), "daemon_start", "start the roc daemon of this discovery environment"),
     (("daemon", "stop"), (), "daemon_stop", "stop the roc daemon of this discovery environment"),
