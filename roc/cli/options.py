@@ -113,4 +113,3 @@ def add_graph_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--spin-time", type=float, metavar="SECONDS",
                         help="without the daemon: how long to discover the graph (default: 3.5, one DDS "
                              "announcement period; less may miss processes)")
-    parser.add_argument("--use-sim-time", action="store_true", help=argparse.SUPPRESS)

@@ -1,20 +1,18 @@
 """Graph queries from a verb: through the roc daemon (started on demand), or locally with ``--no-daemon``.
 
 This module never imports rclpy: a query through a warm daemon costs a socket round trip, not
-rclpy's import time. The protocol is in docs/daemon.md.
+rclpy's import time. Modules only needed to start a daemon are imported when one is started. The protocol is in docs/daemon.md.
 """
 
 from __future__ import annotations
 
 import fcntl
-import hashlib
 import json
 import os
 import socket
-import subprocess
 import sys
-import tempfile
 import time
+import zlib
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Iterator
@@ -39,15 +37,21 @@ def discovery_environment(env: dict[str, str] | None = None) -> dict[str, str]:
 
 
 def daemon_key(env: dict[str, str] | None = None) -> str:
-    """A short hash of the discovery environment and roc's version: one daemon per key."""
-    text = json.dumps([__version__, discovery_environment(env)], sort_keys=True)
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
+    """A short hash of the discovery environment and roc's version: one daemon per key. (A cheap
+    checksum: the daemon's ``hello`` answer is compared in full, so a collision is caught.)"""
+    text = json.dumps([__version__, discovery_environment(env)], sort_keys=True).encode()
+    return f"{zlib.crc32(text):08x}{zlib.adler32(text):08x}"
 
 
 def runtime_dir() -> Path:
     """A directory only this user can enter: $XDG_RUNTIME_DIR/roc or /tmp/roc-UID."""
     base = os.environ.get("XDG_RUNTIME_DIR")
-    path = Path(base) / "roc" if base and Path(base).is_dir() else Path(tempfile.gettempdir()) / f"roc-{os.getuid()}"
+    if base and Path(base).is_dir():
+        path = Path(base) / "roc"
+    else:
+        import tempfile
+
+        path = Path(tempfile.gettempdir()) / f"roc-{os.getuid()}"
     path.mkdir(mode=0o700, parents=True, exist_ok=True)
     if path.stat().st_uid != os.getuid() or path.stat().st_mode & 0o077:
         raise RocError(f"{path}: not private to this user (mode {path.stat().st_mode & 0o777:o}); remove it")
@@ -142,6 +146,8 @@ def start_daemon() -> Connection:
         if connection and _usable(connection):
             return connection
         _wait_gone(path)
+        import subprocess
+
         log = open(path.with_suffix(".log"), "ab")
         subprocess.Popen([sys.executable, "-m", "roc.ros.daemon", str(path)], stdin=subprocess.DEVNULL,
                          stdout=log, stderr=log, start_new_session=True, close_fds=True)
