@@ -61,6 +61,7 @@ def test_same_output_as_ros2(demo, command):
     (("topic", "type", "/nope"), "Unknown topic '/nope'"),
     (("service", "type", "/nope"), "Unknown service '/nope'"),
     (("action", "type", "/nope"), "Unknown action '/nope'"),
+    (("param", "get", "/nope", "x"), "Node not found"),
 ])
 def test_unknown_names_are_one_line_and_exit_1(demo, command, message):
     got = roc(*command, env=demo)

@@ -194,7 +194,10 @@ class Graph:
 
     # -- parameters (service calls to the node) ------------------------------------------------------
     def _call(self, node_name: str, service: str, srv_type, request) -> Any:
-        self._find_node(node_name)
+        try:
+            self._find_node(node_name)
+        except NotFound:
+            raise NotFound("Node not found") from None  # ros2 param's wording
         client = self.node.create_client(srv_type, f"{node_name.rstrip('/')}/{service}")
         try:
             if not client.wait_for_service(timeout_sec=SERVICE_TIMEOUT):
