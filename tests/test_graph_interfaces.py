@@ -20,7 +20,7 @@ def env(tmp_path_factory):
 
 TYPES = ["nav_msgs/msg/Odometry", "geometry_msgs/msg/Twist", "std_srvs/srv/SetBool", "test_msgs/action/Fibonacci",
          "sensor_msgs/msg/Image", "rcl_interfaces/msg/ParameterDescriptor", "visualization_msgs/msg/MarkerArray",
-         "rcl_interfaces/msg/Log", "trajectory_msgs/msg/JointTrajectory"]
+         "rcl_interfaces/msg/Log", "trajectory_msgs/msg/JointTrajectory", "sensor_msgs/msg/CameraInfo"]
 
 
 @pytest.mark.slow

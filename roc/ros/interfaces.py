@@ -90,6 +90,15 @@ def _comment_start(text: str) -> int:
 
 
 _ARRAY = re.compile(r"\[[^\]]*\]$")
+_UNIT = re.compile(r"(\s*\[([^,\]]+)\])")
+
+
+def _comment_text(comment: str) -> str:
+    """A comment's text as rosidl keeps it: a single bracketed unit ('[m/s]') is not part of it."""
+    units = _UNIT.findall(comment)
+    if len(units) == 1:
+        comment = comment.replace(units[0][0], "")
+    return comment.strip()
 
 
 def nested_type(text: str, package: str) -> str | None:
@@ -117,11 +126,11 @@ def show_lines(type_name: str, comments: bool = True, nested_comments: bool = Fa
     for raw in definition_path(type_name).read_text().splitlines():
         text = raw.rstrip()
         start = _comment_start(text)
-        comment = text[start + 1:].strip() if start >= 0 else ""
-        # As ros2 (rosidl's parser): a comment line starts in column 0 and has text ('#' or '##' alone
-        # is no comment, nor is an indented one); a trailing comment is cut one character before its
+        comment = _comment_text(text[start + 1:]) if start >= 0 else ""
+        # As ros2 (rosidl's parser): a comment line starts in column 0 and has text ('#', '##' or a
+        # lone unit such as '# [m]' is no comment, nor is an indented one); a trailing comment is cut one character before its
         # text, which keeps the '#' of '# text'.
-        is_comment = text.startswith("#") and bool(text.lstrip("#").strip())
+        is_comment = text.startswith("#") and bool(_comment_text(text.lstrip("#")))
         shown = text
         if not comments:
             if not text or is_comment:
