@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import sys
 from collections.abc import Iterable, Sequence
+from functools import lru_cache
 from typing import Any, TextIO
 
 
@@ -35,6 +36,40 @@ def to_yaml(data: Any, flow_style: bool | None = False) -> str:
     import yaml
 
     return yaml.dump(data, sort_keys=False, default_flow_style=flow_style, allow_unicode=True)
+
+
+@lru_cache(maxsize=2)
+def _message_dumper(fast: bool) -> type:
+    """A yaml Dumper (libyaml's when ``fast``) whose mappings never take the flow style, as
+    rosidl_runtime_py's OrderedDict representer does."""
+    import yaml
+
+    class MessageDumper(yaml.CDumper if fast else yaml.Dumper):  # type: ignore[misc,name-defined]
+        pass
+
+    def block_mapping(dumper: yaml.Dumper, mapping: dict) -> yaml.MappingNode:
+        items = [(dumper.represent_data(k), dumper.represent_data(v)) for k, v in mapping.items()]
+        return yaml.MappingNode("tag:yaml.org,2002:map", items)
+
+    MessageDumper.add_representer(dict, block_mapping)
+    return MessageDumper
+
+
+def to_message_yaml(data: Any, flow_style: bool = False) -> str:
+    """YAML as ``ros2 topic echo`` prints a message: keys in order, no line wrapping and, with
+    ``flow_style`` (``--flow-style``), lists inline but mappings still in block style.
+
+    libyaml writes the same text 3-4 times faster, except that it escapes characters beyond the
+    BMP (``\\U0001F600``) where PyYAML writes them as they are: such text is redone with PyYAML."""
+    import yaml
+
+    def dump(fast: bool) -> str:
+        return yaml.dump(data, Dumper=_message_dumper(fast), default_flow_style=flow_style, allow_unicode=True,
+                         width=2**31 - 1)  # never wrap (libyaml takes a C int)
+
+    fast = getattr(yaml, "__with_libyaml__", False)
+    text = dump(fast)
+    return dump(False) if fast and "\\U" in text else text
 
 
 def print_yaml(data: Any, stream: TextIO | None = None) -> None:

@@ -104,3 +104,12 @@ def rewrite_passthrough(argv: list[str], known_options: set[str]) -> list[str]:
         current = None
         result.append(token)
     return result
+
+
+def add_graph_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of every verb that queries the ROS graph."""
+    add_format_argument(parser)
+    parser.add_argument("--no-daemon", action="store_true", help="do not use (or start) the roc daemon")
+    parser.add_argument("--spin-time", type=float, metavar="SECONDS",
+                        help="without the daemon: how long to discover the graph (default: 3.5, one DDS "
+                             "announcement period; less may miss processes)")

@@ -1,0 +1,117 @@
+#!/usr/bin/env python3
+"""roc against the real ros2 CLI on one live graph: warm (daemon running) and daemon-less times of
+``topic list``, ``topic info -v``, ``node list`` and ``param get``, plus daemon-less completeness.
+
+    python bench/graph_bench.py [--runs 10] [--no-daemon-runs 3] [--completeness-runs 20]
+
+The graph is the demo graph of the tests (tests/graph_helpers.py: six nodes in three processes) in
+ROS domain 90 with localhost discovery; roc's daemon gets a private runtime directory. The ros2 CLI
+is the oracle of the tests (installed into ~/.cache/roc-tests/ros2cli-venv when missing). Runs of
+the two tools are interleaved; the table shows median wall times and the ratio roc/ros2. "warm" runs
+as in an activated ROS environment (the wheels' bootstrapper does not re-execute Python: the
+bootstrap flag and the wheels' LD_LIBRARY_PATH are set); "plain env" without them, so every Python
+start of either tool re-executes itself once.
+Completeness: ``node list --no-daemon`` run N times by each tool, counted complete when it lists all
+six nodes. Targets: warm roc at most 1/4 of ros2's warm time; daemon-less complete N of N.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from graph_helpers import BIN, DEMO_GRAPH, ORACLE_VENV, graph_env, install_oracle, start_nodes, stop_all, stop_daemon  # noqa: E402
+
+COMMANDS = [("topic", "list"), ("topic", "info", "-v", "/chatter"), ("node", "list"),
+            ("param", "get", "/motor_controller", "max_speed")]
+NODES = ["/fibonacci_server", "/listener", "/map_server", "/motor_controller", "/robot1/odom_pub", "/talker"]
+
+
+def booted(env: dict[str, str], venv: Path) -> dict[str, str]:
+    """``env`` as in an activated ROS environment: the wheels' bootstrapper does not re-execute Python."""
+    site = venv / "lib" / f"python{sys.version_info.major}.{sys.version_info.minor}" / "site-packages"
+    libs = [str(venv / "lib")] + sorted(str(p.resolve()) for p in site.glob("ros_*.libs"))
+    return {**env, "_ROS_WHEELS_BOOTSTRAP_COMPLETE": "1", "LD_LIBRARY_PATH": os.pathsep.join(libs)}
+
+
+def tool_env(env: dict[str, str], boot: bool) -> dict[str, str]:
+    """Booted with this venv's libraries (the oracle's venv holds the same wheels), or plain."""
+    if boot:
+        return booted(env, Path(sys.prefix))
+    return {k: v for k, v in env.items() if k not in ("_ROS_WHEELS_BOOTSTRAP_COMPLETE", "LD_LIBRARY_PATH")}
+
+
+def tool(name: str) -> str:
+    return str(BIN / "roc") if name == "roc" else str(ORACLE_VENV / "bin" / "ros2")
+
+
+def timed(name: str, args: tuple[str, ...], env: dict[str, str], boot: bool = True) -> tuple[float, str, int]:
+    start = time.perf_counter()
+    done = subprocess.run([tool(name), *args], env=tool_env(env, boot), capture_output=True, text=True,
+                          timeout=120)
+    return time.perf_counter() - start, done.stdout, done.returncode
+
+
+def compare(env: dict[str, str], runs: int, extra: tuple[str, ...], boot: bool) -> list[tuple]:
+    """(command, roc median, ros2 median, failed runs of roc, of ros2) per command."""
+    rows = []
+    for command in COMMANDS:
+        times: dict[str, list[float]] = {"roc": [], "ros2": []}
+        failed = {"roc": 0, "ros2": 0}
+        for _ in range(runs):
+            for name in ("roc", "ros2"):
+                elapsed, _, code = timed(name, command + extra, env, boot)
+                times[name].append(elapsed)
+                failed[name] += code != 0
+        rows.append((" ".join(command), statistics.median(times["roc"]), statistics.median(times["ros2"]),
+                     failed["roc"], failed["ros2"]))
+    return rows
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=10)
+    parser.add_argument("--no-daemon-runs", type=int, default=3)
+    parser.add_argument("--completeness-runs", type=int, default=20)
+    options = parser.parse_args()
+    reason = install_oracle()
+    if reason:
+        raise SystemExit(f"the ros2 CLI is not available: {reason}")
+    runtime = Path(tempfile.mkdtemp(prefix="roc-graph-bench-"))
+    env = graph_env(90, runtime)
+    env["ROS_DOMAIN_ID"] = "90"
+    processes = start_nodes(DEMO_GRAPH, env)
+    try:
+        for name in ("roc", "ros2"):
+            subprocess.run([tool(name), "daemon", "start"], env=env, capture_output=True, timeout=60)
+        time.sleep(4)
+        for name in ("roc", "ros2"):  # warm-up
+            timed(name, ("topic", "list"), env)
+        print(f"{'command':50} {'roc s':>7} {'ros2 s':>7} {'roc/ros2':>8}  failed runs roc, ros2")
+        modes = (("warm", (), options.runs, True), ("no daemon", ("--no-daemon",), options.no_daemon_runs, True))
+        for label, extra, runs, boot in modes:
+            for command, roc_time, ros2_time, roc_failed, ros2_failed in compare(env, runs, extra, boot):
+                print(f"{command + ' (' + label + ')':50} {roc_time:7.3f} {ros2_time:7.3f} "
+                      f"{roc_time / ros2_time:8.2f}  {roc_failed}, {ros2_failed}")
+        for name in ("roc", "ros2"):
+            complete = 0
+            for _ in range(options.completeness_runs):
+                _, out, _ = timed(name, ("node", "list", "--no-daemon"), env)
+                complete += out.splitlines() == NODES
+            print(f"{name} node list --no-daemon complete in {complete} of {options.completeness_runs} runs")
+    finally:
+        stop_daemon(env)
+        subprocess.run([tool("ros2"), "daemon", "stop"], env=env, capture_output=True, timeout=60)
+        stop_all(processes)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

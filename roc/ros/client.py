@@ -1,0 +1,209 @@
+"""Graph queries from a verb: through the roc daemon (started on demand), or locally with ``--no-daemon``.
+
+This module never imports rclpy: a query through a warm daemon costs a socket round trip, not
+rclpy's import time. Modules only needed to start a daemon are imported when one is started. The protocol is in docs/daemon.md.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import json
+import os
+import socket
+import sys
+import time
+import zlib
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any, Iterator
+
+from roc import __version__
+from roc.errors import RocError
+
+# The variables that decide what a participant discovers: a daemon serves one set of values.
+DISCOVERY_VARIABLES = ("ROS_DOMAIN_ID", "RMW_IMPLEMENTATION", "ROS_AUTOMATIC_DISCOVERY_RANGE",
+                       "ROS_STATIC_PEERS", "ROS_LOCALHOST_ONLY")
+REQUEST_TIMEOUT = float(os.environ.get("ROC_DAEMON_TIMEOUT", "30"))
+START_TIMEOUT = 15.0
+
+
+class DaemonError(RocError):
+    """The daemon answered with an error (its message is for the user)."""
+
+
+def discovery_environment(env: dict[str, str] | None = None) -> dict[str, str]:
+    env = os.environ if env is None else env
+    return {name: env.get(name, "") for name in DISCOVERY_VARIABLES}
+
+
+def daemon_key(env: dict[str, str] | None = None) -> str:
+    """A short hash of the discovery environment and roc's version: one daemon per key. (A cheap
+    checksum: the daemon's ``hello`` answer is compared in full, so a collision is caught.)"""
+    text = json.dumps([__version__, discovery_environment(env)], sort_keys=True).encode()
+    return f"{zlib.crc32(text):08x}{zlib.adler32(text):08x}"
+
+
+def runtime_dir() -> Path:
+    """A directory only this user can enter: $XDG_RUNTIME_DIR/roc or /tmp/roc-UID."""
+    base = os.environ.get("XDG_RUNTIME_DIR")
+    if base and Path(base).is_dir():
+        path = Path(base) / "roc"
+    else:
+        import tempfile
+
+        path = Path(tempfile.gettempdir()) / f"roc-{os.getuid()}"
+    path.mkdir(mode=0o700, parents=True, exist_ok=True)
+    if path.stat().st_uid != os.getuid() or path.stat().st_mode & 0o077:
+        raise RocError(f"{path}: not private to this user (mode {path.stat().st_mode & 0o777:o}); remove it")
+    return path
+
+
+def socket_path(env: dict[str, str] | None = None) -> Path:
+    return runtime_dir() / f"daemon-{daemon_key(env)}.sock"
+
+
+class Connection:
+    """One client connection: JSON lines out, JSON lines in."""
+
+    def __init__(self, sock: socket.socket):
+        self.sock = sock
+        self.reader = sock.makefile("r", encoding="utf-8")
+        self.next_id = 0
+
+    def stream(self, method: str, params: dict[str, Any] | None = None,
+               timeout: float = REQUEST_TIMEOUT) -> Iterator[dict[str, Any]]:
+        """Send a request; yield each response line until the final one (``"final": true``)."""
+        self.next_id += 1
+        request = {"id": self.next_id, "method": method, "params": params or {}}
+        self.sock.settimeout(timeout)
+        try:
+            self.sock.sendall((json.dumps(request) + "\n").encode())
+            while True:
+                line = self.reader.readline()
+                if not line:
+                    raise RocError("the roc daemon closed the connection; run 'roc daemon stop' and retry")
+                response = json.loads(line)
+                yield response
+                if response.get("final"):
+                    return
+        except socket.timeout:
+            raise RocError(f"the roc daemon did not answer '{method}' within {timeout:g} s") from None
+
+    def request(self, method: str, params: dict[str, Any] | None = None, timeout: float = REQUEST_TIMEOUT) -> Any:
+        final = list(self.stream(method, params, timeout))[-1]
+        if "error" in final:
+            raise DaemonError(final["error"]["message"])
+        return final.get("result")
+
+    def close(self) -> None:
+        self.reader.close()
+        self.sock.close()
+
+
+def connect(path: Path | None = None) -> Connection | None:
+    """A connection to the running daemon, or None (a dead socket file is removed)."""
+    path = path or socket_path()
+    if not path.exists():
+        return None
+    sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    try:
+        sock.connect(str(path))
+    except (ConnectionRefusedError, FileNotFoundError):
+        sock.close()
+        path.unlink(missing_ok=True)
+        return None
+    return Connection(sock)
+
+
+@contextmanager
+def _start_lock(path: Path):
+    with open(path.with_suffix(".lock"), "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        yield
+
+
+def _usable(connection: Connection) -> bool:
+    """The daemon is of this roc version and serves this discovery environment; else it is stopped."""
+    hello = connection.request("hello", timeout=10)
+    if hello.get("version") == __version__ and hello.get("environment") == discovery_environment():
+        return True
+    try:
+        connection.request("shutdown", timeout=5)
+    except RocError:
+        pass
+    connection.close()
+    return False
+
+
+def start_daemon() -> Connection:
+    """The running daemon, started (detached, in its own session) if there is none."""
+    path = socket_path()
+    connection = connect(path)
+    if connection and _usable(connection):
+        return connection
+    with _start_lock(path):
+        connection = connect(path)
+        if connection and _usable(connection):
+            return connection
+        _wait_gone(path)
+        import subprocess
+
+        log = open(path.with_suffix(".log"), "ab")
+        subprocess.Popen([sys.executable, "-m", "roc.ros.daemon", str(path)], stdin=subprocess.DEVNULL,
+                         stdout=log, stderr=log, start_new_session=True, close_fds=True)
+        log.close()
+        deadline = time.monotonic() + START_TIMEOUT
+        while time.monotonic() < deadline:
+            connection = connect(path)
+            if connection:
+                return connection
+            time.sleep(0.02)
+    raise RocError(f"the roc daemon did not start within {START_TIMEOUT:g} s; see {path.with_suffix('.log')}")
+
+
+def _wait_gone(path: Path, timeout: float = 5.0) -> None:
+    """Give a daemon that was told to stop the time to remove its socket."""
+    deadline = time.monotonic() + timeout
+    while path.exists() and time.monotonic() < deadline:
+        if connect(path) is None:
+            return
+        time.sleep(0.05)
+
+
+def stop_daemon() -> bool:
+    """Stop this environment's daemon; False when none was running."""
+    path = socket_path()
+    connection = connect(path)
+    if connection is None:
+        return False
+    try:
+        connection.request("shutdown", timeout=5)
+    finally:
+        connection.close()
+    _wait_gone(path)
+    return True
+
+
+def daemon_status() -> dict[str, Any] | None:
+    connection = connect()
+    if connection is None:
+        return None
+    try:
+        return connection.request("hello", timeout=5)
+    finally:
+        connection.close()
+
+
+def query(method: str, params: dict[str, Any] | None = None, *, use_daemon: bool = True,
+          spin_time: float | None = None) -> Any:
+    """Answer a graph request, through the daemon unless ``use_daemon`` is false."""
+    params = params or {}
+    if not use_daemon:
+        from roc.ros.graph import local_query
+
+        return local_query(method, params, spin_time)
+    connection = start_daemon()
+    try:
+        return connection.request(method, params)
+    finally:
+        connection.close()

@@ -1,0 +1,127 @@
+"""The roc daemon: one warm graph participant per user and discovery environment, answering JSON-line
+requests on a Unix socket (mode 0600). Started by roc.ros.client; run as
+``python -m roc.ros.daemon SOCKET``. The protocol is in docs/daemon.md.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+from roc import __version__
+from roc.errors import RocError
+from roc.ros.client import discovery_environment
+
+IDLE_SECONDS = float(os.environ.get("ROC_DAEMON_IDLE_SECONDS", "3600"))
+
+
+class Daemon:
+    def __init__(self, path: Path):
+        self.path = path
+        self.last_request = time.monotonic()
+        self.stopping = threading.Event()
+        self.ready = threading.Event()
+        self.graph = None
+        self.started = time.time()
+
+    def serve(self) -> None:
+        # Bound and listening under a temporary name, then renamed into place: a client never finds
+        # the path refusing connections (it would take it for a dead daemon's socket and remove it).
+        listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        staging = self.path.with_name(f".{self.path.name}.{os.getpid()}")
+        staging.unlink(missing_ok=True)
+        old_umask = os.umask(0o177)
+        try:
+            listener.bind(str(staging))
+        finally:
+            os.umask(old_umask)
+        os.chmod(staging, 0o600)
+        listener.listen(64)
+        os.replace(staging, self.path)
+        self._inode = self.path.stat().st_ino
+        listener.settimeout(0.5)
+        threading.Thread(target=self._discover, daemon=True).start()
+        try:
+            while not self.stopping.is_set():
+                if time.monotonic() - self.last_request > IDLE_SECONDS:
+                    break
+                try:
+                    conn, _ = listener.accept()
+                except socket.timeout:
+                    continue
+                threading.Thread(target=self._client, args=(conn,), daemon=True).start()
+        finally:
+            listener.close()
+            # Only remove the socket if it is still ours (a replacement may have bound the path).
+            try:
+                if self.path.stat().st_ino == self._inode:
+                    self.path.unlink()
+            except FileNotFoundError:
+                pass
+            if self.graph is not None:
+                self.graph.close()
+
+    def _discover(self) -> None:
+        from roc.ros.graph import Graph
+
+        self.graph = Graph()
+        self.graph.wait_for_discovery()
+        self.ready.set()
+
+    def _client(self, conn: socket.socket) -> None:
+        with conn, conn.makefile("r", encoding="utf-8") as reader:
+            for line in reader:
+                self.last_request = time.monotonic()
+                try:
+                    request = json.loads(line)
+                    request_id = request.get("id")
+                except (json.JSONDecodeError, AttributeError):
+                    request, request_id = {}, None
+                for response in self._answer(request):
+                    response["id"] = request_id
+                    conn.sendall((json.dumps(response) + "\n").encode())
+                if request.get("method") == "shutdown":
+                    return
+
+    def _answer(self, request: dict[str, Any]):
+        """The response lines of one request; the last carries ``final: true``. Streaming requests
+        (a later issue) yield ``{"event": ...}`` lines before it."""
+        method = request.get("method")
+        try:
+            if method == "hello":
+                result = {"version": __version__, "pid": os.getpid(), "environment": discovery_environment(),
+                          "started": self.started, "ready": self.ready.is_set(), "socket": str(self.path)}
+            elif method == "shutdown":
+                self.stopping.set()
+                result = {"stopping": True}
+            elif not isinstance(method, str):
+                raise RocError("a request needs a 'method'")
+            else:
+                if not self.ready.wait(30):
+                    raise RocError("the daemon's graph participant did not start")
+                result = self.graph.handle(method, request.get("params") or {})
+            yield {"final": True, "result": result}
+        except RocError as error:
+            yield {"final": True, "error": {"kind": type(error).__name__, "message": str(error)}}
+        except Exception as error:  # noqa: BLE001 - the daemon outlives a bad request
+            yield {"final": True, "error": {"kind": "internal", "message": f"{type(error).__name__}: {error}"}}
+
+
+def main() -> None:
+    path = Path(sys.argv[1])
+    daemon = Daemon(path)
+    signal.signal(signal.SIGTERM, lambda *_: daemon.stopping.set())
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    os.chdir("/")
+    daemon.serve()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,314 @@
+"""The ROS graph as plain data: the one place that creates an rclpy context and node.
+
+rcl reads the discovery environment itself (``ROS_DOMAIN_ID``, ``RMW_IMPLEMENTATION``,
+``ROS_AUTOMATIC_DISCOVERY_RANGE``, ``ROS_STATIC_PEERS``, ``ROS_LOCALHOST_ONLY``), so a ``Graph`` sees
+what ros2 sees in the same environment. Every query returns dicts and lists (JSON-ready) and
+never prints; ``handle`` maps a request (method name and parameters) to one of them, for the
+daemon and for daemon-less runs alike.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+from typing import Any
+
+import rclpy
+from rclpy.action import graph as action_graph
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
+
+from roc.errors import RocError
+
+# Without a daemon, discovery lasts one Fast DDS announcement period and a margin (3.5 s: measured on
+# localhost, processes keep appearing up to 3 s after a fresh participant starts, with gaps of almost
+# 2 s: a participant outside the initial peers' range is heard at its next periodic announcement,
+# so no shorter quiet period is complete), then until the graph has been quiet for QUIET_SECONDS and
+# every endpoint's node is known, at most EXTRA_SECONDS longer. ``--spin-time`` sets the period.
+QUIET_SECONDS = 0.3
+DEFAULT_SPIN_TIME = 3.5
+EXTRA_SECONDS = 1.0
+POLL_SECONDS = 0.05
+SERVICE_TIMEOUT = 5.0
+
+
+class NotFound(RocError):
+    """An unknown topic, node, service, action or parameter (the message is ros2's wording)."""
+
+
+def _duration_ns(duration) -> int | None:
+    """Nanoseconds, None for an infinite duration."""
+    from rclpy.duration import Infinite
+
+    return None if duration == Infinite else duration.nanoseconds
+
+
+def _endpoint(info) -> dict[str, Any]:
+    qos = info.qos_profile
+    return {
+        "node_name": info.node_name,
+        "node_namespace": info.node_namespace,
+        "topic_type": info.topic_type,
+        "topic_type_hash": str(info.topic_type_hash),
+        "endpoint_type": info.endpoint_type.name,
+        "gid": ".".join(format(x, "02x") for x in info.endpoint_gid),
+        "qos": {
+            "reliability": qos.reliability.name,
+            "history": qos.history.name,
+            "depth": qos.depth,
+            "durability": qos.durability.name,
+            "lifespan_ns": _duration_ns(qos.lifespan),
+            "deadline_ns": _duration_ns(qos.deadline),
+            "liveliness": qos.liveliness.name,
+            "liveliness_lease_duration_ns": _duration_ns(qos.liveliness_lease_duration),
+        },
+    }
+
+
+def _names_and_types(pairs) -> list[dict[str, Any]]:
+    return [{"name": name, "types": list(types)} for name, types in sorted(pairs)]
+
+
+def full_name(namespace: str, name: str) -> str:
+    return f"{namespace.rstrip('/')}/{name}"
+
+
+class Graph:
+    """A hidden rclpy node in its own context, spun in a background thread (for service calls)."""
+
+    def __init__(self) -> None:
+        self.context = Context()
+        rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)
+        self.node = Node(f"_roc_{os.getpid()}", context=self.context, start_parameter_services=False,
+                         enable_rosout=False)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self._spinner = threading.Thread(target=self._spin, daemon=True)
+        self._spinner.start()
+
+    def _spin(self) -> None:
+        try:
+            self.executor.spin()
+        except Exception:  # noqa: BLE001 - the context was shut down under it
+            pass
+
+    def close(self) -> None:
+        rclpy.try_shutdown(context=self.context)
+        self._spinner.join(timeout=2)
+        self.executor.shutdown(timeout_sec=1)
+        self.node.destroy_node()
+
+    # -- discovery ------------------------------------------------------------------------------------
+    def signature(self) -> tuple:
+        node = self.node
+        return (tuple(sorted(node.get_node_names_and_namespaces())),
+                tuple((n, tuple(t), node.count_publishers(n), node.count_subscribers(n))
+                      for n, t in sorted(node.get_topic_names_and_types())),
+                tuple((n, tuple(t)) for n, t in sorted(node.get_service_names_and_types())))
+
+    def wait_for_discovery(self, period: float = DEFAULT_SPIN_TIME, quiet: float = QUIET_SECONDS) -> None:
+        """Return after ``period`` once the graph has been unchanged for ``quiet`` seconds and is
+        consistent, or at ``period`` + EXTRA_SECONDS."""
+        start = last_change = time.monotonic()
+        last = self.signature()
+        while True:
+            time.sleep(POLL_SECONDS)
+            now = time.monotonic()
+            current = self.signature()
+            if current != last:
+                last, last_change = current, now
+            elif now - start >= period and now - last_change >= quiet and self._complete():
+                return
+            if now - start >= period + EXTRA_SECONDS:
+                return
+
+    def _complete(self) -> bool:
+        """Every endpoint's node is known (a participant seen before its node names is not complete)."""
+        node = self.node
+        for name, _ in node.get_topic_names_and_types():
+            for info in (*node.get_publishers_info_by_topic(name), *node.get_subscriptions_info_by_topic(name)):
+                if info.node_name == "_NODE_NAME_UNKNOWN_":
+                    return False
+        return True
+
+    # -- queries --------------------------------------------------------------------------------------
+    def snapshot(self) -> dict[str, Any]:
+        """Nodes, topics (with endpoint counts), services and actions."""
+        node = self.node
+        topics = _names_and_types(node.get_topic_names_and_types())
+        for topic in topics:
+            topic["publishers"] = node.count_publishers(topic["name"])
+            topic["subscribers"] = node.count_subscribers(topic["name"])
+        return {
+            "nodes": [{"name": name, "namespace": namespace, "full_name": full_name(namespace, name)}
+                      for name, namespace in sorted(node.get_node_names_and_namespaces(),
+                                                    key=lambda p: full_name(p[1], p[0]))],
+            "topics": topics,
+            "services": _names_and_types(node.get_service_names_and_types()),
+            "actions": _names_and_types(action_graph.get_action_names_and_types(node)),
+        }
+
+    def topic_endpoints(self, topic: str) -> dict[str, Any]:
+        node = self.node
+        types = dict(node.get_topic_names_and_types()).get(topic)
+        if types is None:
+            raise NotFound(f"Unknown topic '{topic}'")
+        return {"name": topic, "types": list(types),
+                "publishers": [_endpoint(i) for i in node.get_publishers_info_by_topic(topic)],
+                "subscribers": [_endpoint(i) for i in node.get_subscriptions_info_by_topic(topic)]}
+
+    def _find_node(self, name: str) -> tuple[str, str]:
+        for node_name, namespace in self.node.get_node_names_and_namespaces():
+            if full_name(namespace, node_name) == name:
+                return node_name, namespace
+        raise NotFound(f"Unable to find node '{name}'")
+
+    def node_info(self, name: str) -> dict[str, Any]:
+        node_name, namespace = self._find_node(name)
+        node = self.node
+        return {
+            "name": full_name(namespace, node_name),
+            "subscribers": _names_and_types(node.get_subscriber_names_and_types_by_node(node_name, namespace)),
+            "publishers": _names_and_types(node.get_publisher_names_and_types_by_node(node_name, namespace)),
+            "service_servers": _names_and_types(node.get_service_names_and_types_by_node(node_name, namespace)),
+            "service_clients": _names_and_types(node.get_client_names_and_types_by_node(node_name, namespace)),
+            "action_servers": _names_and_types(
+                action_graph.get_action_server_names_and_types_by_node(node, node_name, namespace)),
+            "action_clients": _names_and_types(
+                action_graph.get_action_client_names_and_types_by_node(node, node_name, namespace)),
+        }
+
+    def action_info(self, action: str) -> dict[str, Any]:
+        """The nodes serving and using ``action`` with the types they give it."""
+        servers, clients = [], []
+        for node_name, namespace in sorted(self.node.get_node_names_and_namespaces()):
+            for found, query in ((servers, action_graph.get_action_server_names_and_types_by_node),
+                                 (clients, action_graph.get_action_client_names_and_types_by_node)):
+                for name, types in query(self.node, node_name, namespace):
+                    if name == action:
+                        found.append({"node": full_name(namespace, node_name), "types": list(types)})
+        return {"name": action, "servers": servers, "clients": clients}
+
+    # -- parameters (service calls to the node) ------------------------------------------------------
+    def _call(self, node_name: str, service: str, srv_type, request) -> Any:
+        try:
+            self._find_node(node_name)
+        except NotFound:
+            raise NotFound("Node not found") from None  # ros2 param's wording
+        client = self.node.create_client(srv_type, f"{node_name.rstrip('/')}/{service}")
+        try:
+            if not client.wait_for_service(timeout_sec=SERVICE_TIMEOUT):
+                raise RocError(f"{node_name}: parameter service '{service}' not available")
+            done = threading.Event()
+            future = client.call_async(request)
+            future.add_done_callback(lambda _: done.set())
+            if not done.wait(SERVICE_TIMEOUT):
+                raise RocError(f"{node_name}: '{service}' did not answer within {SERVICE_TIMEOUT:g} s")
+            return future.result()
+        finally:
+            self.node.destroy_client(client)
+
+    def param_names(self, node_name: str, prefixes: list[str] | None = None) -> list[str]:
+        from rcl_interfaces.srv import ListParameters
+
+        request = ListParameters.Request(prefixes=prefixes or [], depth=0)
+        return sorted(self._call(node_name, "list_parameters", ListParameters, request).result.names)
+
+    def param_values(self, node_name: str, names: list[str]) -> list[dict[str, Any]]:
+        from rcl_interfaces.srv import GetParameters
+
+        response = self._call(node_name, "get_parameters", GetParameters, GetParameters.Request(names=names))
+        return [parameter_value(v) for v in response.values]
+
+    def param_types(self, node_name: str, names: list[str]) -> list[int]:
+        from rcl_interfaces.srv import GetParameterTypes
+
+        request = GetParameterTypes.Request(names=names)
+        return list(self._call(node_name, "get_parameter_types", GetParameterTypes, request).types)
+
+    def param_descriptors(self, node_name: str, names: list[str]) -> list[dict[str, Any]]:
+        from rcl_interfaces.srv import DescribeParameters
+
+        request = DescribeParameters.Request(names=names)
+        response = self._call(node_name, "describe_parameters", DescribeParameters, request)
+        return [{
+            "name": d.name, "type": PARAMETER_TYPES.get(d.type, "not set"), "description": d.description,
+            "additional_constraints": d.additional_constraints, "read_only": d.read_only,
+            "dynamic_typing": d.dynamic_typing,
+            "floating_point_range": [{"from_value": r.from_value, "to_value": r.to_value, "step": r.step}
+                                     for r in d.floating_point_range],
+            "integer_range": [{"from_value": r.from_value, "to_value": r.to_value, "step": r.step}
+                              for r in d.integer_range],
+        } for d in response.descriptors]
+
+    def param_list(self, node_name: str | None, prefixes: list[str] | None, with_types: bool) -> list[dict]:
+        """[{node, parameters: [{name, type?}]}] for one node or every node."""
+        names = [node_name] if node_name else [n["full_name"] for n in self.snapshot()["nodes"]
+                                               if not n["name"].startswith("_")]
+        result = []
+        for name in names:
+            try:
+                params = self.param_names(name, prefixes)
+            except RocError:
+                if node_name:
+                    raise
+                continue  # a node without parameter services: ros2 leaves it out too
+            entry = [{"name": p} for p in params]
+            if with_types and params:
+                for item, kind in zip(entry, self.param_types(name, params)):
+                    item["type"] = PARAMETER_TYPES.get(kind, "not set")
+            result.append({"node": name, "parameters": entry})
+        return result
+
+    def handle(self, method: str, params: dict[str, Any]) -> Any:
+        """One request of the daemon protocol (see docs/daemon.md)."""
+        if method == "snapshot":
+            return self.snapshot()
+        if method == "topic_endpoints":
+            return self.topic_endpoints(params["topic"])
+        if method == "node_info":
+            return self.node_info(params["node"])
+        if method == "action_info":
+            return self.action_info(params["action"])
+        if method == "param_list":
+            return self.param_list(params.get("node"), params.get("prefixes"), params.get("types", False))
+        if method == "param_get":
+            names = params["names"]
+            return self.param_values(params["node"], names)
+        if method == "param_describe":
+            return self.param_descriptors(params["node"], params["names"])
+        if method == "param_dump":
+            names = self.param_names(params["node"])
+            return dict(zip(names, self.param_values(params["node"], names)))
+        raise RocError(f"unknown request '{method}'")
+
+
+PARAMETER_TYPES = {0: "not set", 1: "boolean", 2: "integer", 3: "double", 4: "string", 5: "byte array",
+                   6: "boolean array", 7: "integer array", 8: "double array", 9: "string array"}
+_VALUE_FIELDS = {1: "bool_value", 2: "integer_value", 3: "double_value", 4: "string_value",
+                 5: "byte_array_value", 6: "bool_array_value", 7: "integer_array_value",
+                 8: "double_array_value", 9: "string_array_value"}
+
+
+def parameter_value(value) -> dict[str, Any]:
+    """{type, value} of an rcl_interfaces ParameterValue, the value as plain JSON data."""
+    field = _VALUE_FIELDS.get(value.type)
+    data = getattr(value, field) if field else None
+    if field == "byte_array_value":
+        data = [b if isinstance(b, int) else ord(b) for b in data]
+    elif field and field.endswith("_array_value"):
+        data = list(data)
+    return {"type": PARAMETER_TYPES.get(value.type, "not set"), "value": data}
+
+
+def local_query(method: str, params: dict[str, Any], spin_time: float | None) -> Any:
+    """Answer one request without a daemon: a fresh participant, discovery, the query."""
+    graph = Graph()
+    try:
+        graph.wait_for_discovery(spin_time if spin_time is not None else DEFAULT_SPIN_TIME)
+        return graph.handle(method, params)
+    finally:
+        graph.close()

@@ -1,0 +1,96 @@
+"""Helpers for the graph tests: test nodes in subprocesses, roc and the real ros2 CLI in one environment."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+from build_helpers import BIN, ros_domain_id, stop_process
+
+NODE_SCRIPT = Path(__file__).resolve().parent / "graph_node.py"
+ORACLE_VENV = Path(os.environ.get("ROC_TEST_CACHE", Path.home() / ".cache" / "roc-tests")) / "ros2cli-venv"
+SHARED = Path(__file__).resolve().parents[2] / "shared"
+
+# The demo graph of shared/reference/ros2cli, in three processes.
+DEMO_GRAPH = [
+    [{"name": "talker", "publishers": [{"topic": "chatter", "type": "std_msgs/msg/String"}]},
+     {"name": "listener", "subscribers": [{"topic": "chatter", "type": "std_msgs/msg/String"}]}],
+    [{"name": "odom_pub", "namespace": "/robot1",
+      "publishers": [{"topic": "odom", "type": "nav_msgs/msg/Odometry", "reliability": "best_effort", "depth": 5}]},
+     {"name": "map_server", "publishers": [{"topic": "map", "type": "nav_msgs/msg/OccupancyGrid",
+                                             "durability": "transient_local", "depth": 1}]}],
+    [{"name": "motor_controller", "services": [{"name": "~/enable", "type": "std_srvs/srv/SetBool"},
+                                               {"name": "~/reset", "type": "std_srvs/srv/Trigger"}],
+      "parameters": {"max_speed": 1.5, "robot_name": "demo_bot", "update_rate_hz": 50, "use_encoder": True,
+                     "pid_gains": [1.0, 0.1, 0.01], "wheel_names": ["left_wheel", "right_wheel"]}},
+     {"name": "fibonacci_server", "actions": [{"name": "fibonacci"}]}],
+]
+
+
+def graph_env(base: int, runtime_dir: Path, **extra: str) -> dict[str, str]:
+    """A private ROS domain, localhost discovery and a private daemon directory."""
+    env = dict(os.environ)
+    env.pop("ROS_LOCALHOST_ONLY", None)
+    env.update(ROS_DOMAIN_ID=ros_domain_id(base), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
+               XDG_RUNTIME_DIR=str(runtime_dir), AMENT_PREFIX_PATH=f"{ORACLE_VENV}{os.pathsep}{sys.prefix}",
+               PATH=f"{BIN}{os.pathsep}{env.get('PATH', '/usr/bin:/bin')}")
+    env.update(extra)
+    return env
+
+
+def start_nodes(specs: list, env: dict[str, str]) -> list[subprocess.Popen]:
+    """One process per entry of ``specs``; returns once each printed "ready"."""
+    processes = []
+    for spec in specs:
+        process = subprocess.Popen([sys.executable, str(NODE_SCRIPT), json.dumps(spec)], env=env,
+                                   stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        processes.append(process)
+    for process in processes:
+        assert process.stdout.readline().strip() == "ready"
+    return processes
+
+
+def stop_all(processes: list[subprocess.Popen]) -> None:
+    for process in processes:
+        stop_process(process)
+
+
+def roc(*args: str, env: dict[str, str], timeout: float = 60) -> subprocess.CompletedProcess:
+    return subprocess.run([str(BIN / "roc"), *args], env=env, capture_output=True, text=True, timeout=timeout)
+
+
+def ros2(*args: str, env: dict[str, str], timeout: float = 60) -> subprocess.CompletedProcess:
+    return subprocess.run([str(ORACLE_VENV / "bin" / "ros2"), *args], env=env, capture_output=True, text=True,
+                          timeout=timeout)
+
+
+def install_oracle() -> str | None:
+    """Install the real ros2 CLI into the cached venv; the reason it failed, or None."""
+    if (ORACLE_VENV / "bin" / "ros2").exists():
+        return None
+    script = SHARED / "oracles" / "install_ros2cli.sh"
+    if not script.is_file():
+        return f"no oracle installer at {script}"
+    base = getattr(sys, "_base_executable", sys.executable)
+    made = subprocess.run([base, "-m", "venv", str(ORACLE_VENV)], capture_output=True, text=True)
+    if made.returncode != 0:
+        return f"cannot create {ORACLE_VENV}: {made.stderr.strip()}"
+    installed = subprocess.run(["bash", str(script), str(ORACLE_VENV)], capture_output=True, text=True, timeout=900)
+    if installed.returncode != 0:
+        return f"install_ros2cli.sh failed: {installed.stderr.strip()[-300:]}"
+    return None
+
+
+def stop_daemon(env: dict[str, str]) -> None:
+    """Stop roc's daemon of ``env`` (by its PID if it does not answer), and ros2's."""
+    status = roc("daemon", "status", "--format", "json", env=env)
+    pid = json.loads(status.stdout).get("pid") if status.returncode == 0 and status.stdout else None
+    roc("daemon", "stop", env=env)
+    if pid:
+        try:
+            os.kill(pid, 9)
+        except ProcessLookupError:
+            pass

@@ -1,0 +1,73 @@
+"""A test node for the graph tests: publishes, subscribes, serves and holds parameters as told.
+
+    python graph_node.py '{"name": "talker", "namespace": "/", "publishers": [{"topic": "chatter",
+        "type": "std_msgs/msg/String", "reliability": "best_effort", "durability": "volatile",
+        "depth": 10, "deadline_ms": 0}], "subscribers": [...], "services": [{"name": "reset",
+        "type": "std_srvs/srv/Trigger"}], "actions": [{"name": "fibonacci"}], "parameters": {"max_speed": 1.5}}'
+
+Several nodes in one process: pass a JSON list. Prints "ready" once everything is created, then
+spins until killed.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import sys
+
+import rclpy
+from rclpy.duration import Duration
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
+
+def load(type_name: str):
+    package, kind, name = type_name.split("/")
+    return getattr(importlib.import_module(f"{package}.{kind}"), name)
+
+
+def qos(spec: dict) -> QoSProfile:
+    profile = QoSProfile(depth=spec.get("depth", 10),
+                         reliability=ReliabilityPolicy[spec.get("reliability", "reliable").upper()],
+                         durability=DurabilityPolicy[spec.get("durability", "volatile").upper()])
+    if spec.get("deadline_ms"):
+        profile.deadline = Duration(nanoseconds=spec["deadline_ms"] * 1_000_000)
+    return profile
+
+
+def make_node(spec: dict) -> Node:
+    node = Node(spec["name"], namespace=spec.get("namespace", "/"))
+    for name, value in spec.get("parameters", {}).items():
+        node.declare_parameter(name, value)
+    for pub in spec.get("publishers", []):
+        node.create_publisher(load(pub["type"]), pub["topic"], qos(pub))
+    for sub in spec.get("subscribers", []):
+        node.create_subscription(load(sub["type"]), sub["topic"], lambda _msg: None, qos(sub))
+    for srv in spec.get("services", []):
+        node.create_service(load(srv["type"]), srv["name"], lambda _req, resp: resp)
+    for client in spec.get("clients", []):
+        node.create_client(load(client["type"]), client["name"])
+    for action in spec.get("actions", []):
+        from rclpy.action import ActionServer
+
+        node._roc_action = ActionServer(node, load(action.get("type", "test_msgs/action/Fibonacci")),
+                                        action["name"], lambda goal: None)
+    return node
+
+
+def main() -> None:
+    specs = json.loads(sys.argv[1])
+    rclpy.init()
+    executor = SingleThreadedExecutor()
+    for spec in specs if isinstance(specs, list) else [specs]:
+        executor.add_node(make_node(spec))
+    print("ready", flush=True)
+    try:
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,128 @@
+"""The roc daemon's lifecycle: auto start, status, stop, replacement, socket mode, concurrent clients;
+and daemon-less discovery that is complete on a graph of several processes."""
+
+from __future__ import annotations
+
+import json
+import os
+import stat
+import subprocess
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+
+from graph_helpers import BIN, graph_env, roc, start_nodes, stop_all, stop_daemon
+
+pytestmark = pytest.mark.slow
+
+
+def status(env: dict[str, str]) -> dict:
+    return json.loads(roc("daemon", "status", "--format", "json", env=env).stdout)
+
+
+@pytest.fixture
+def talker(tmp_path):
+    env = graph_env(30, tmp_path / "runtime")
+    (tmp_path / "runtime").mkdir()
+    processes = start_nodes([{"name": "talker", "publishers": [{"topic": "chatter", "type": "std_msgs/msg/String"}]}],
+                            env)
+    yield env
+    stop_daemon(env)
+    stop_daemon({**env, "ROS_DOMAIN_ID": str(int(env["ROS_DOMAIN_ID"]) + 20)})
+    stop_all(processes)
+
+
+def test_lifecycle(talker):
+    env = talker
+    assert roc("daemon", "status", env=env).stdout == "The daemon is not running\n"
+    listed = roc("topic", "list", env=env)  # starts the daemon
+    assert listed.returncode == 0 and "/chatter" in listed.stdout.splitlines()
+    first = status(env)
+    assert first["running"] and first["environment"]["ROS_DOMAIN_ID"] == env["ROS_DOMAIN_ID"]
+    sock = Path(first["socket"])
+    assert stat.S_IMODE(sock.stat().st_mode) == 0o600
+    assert stat.S_IMODE(sock.parent.stat().st_mode) == 0o700
+    assert roc("daemon", "status", env=env).stdout == "The daemon is running\n"
+
+    # Another discovery environment gets its own daemon.
+    other = {**env, "ROS_DOMAIN_ID": str(int(env["ROS_DOMAIN_ID"]) + 20)}
+    assert "/chatter" not in roc("topic", "list", env=other).stdout.splitlines()
+    assert status(other)["pid"] != first["pid"]
+
+    # A killed daemon leaves a dead socket: cleaned up and replaced.
+    os.kill(first["pid"], 9)
+    time.sleep(0.2)
+    assert sock.exists()
+    assert "/chatter" in roc("topic", "list", env=env).stdout.splitlines()
+    second = status(env)
+    assert second["pid"] != first["pid"]
+
+    assert roc("daemon", "stop", env=env).stdout == "The daemon has been stopped\n"
+    assert not sock.exists()
+    assert roc("daemon", "stop", env=env).stdout == "The daemon is not running\n"
+
+
+def test_concurrent_clients_share_one_daemon(talker):
+    env = talker
+    with ThreadPoolExecutor(6) as pool:
+        results = list(pool.map(lambda _: roc("node", "list", env=env), range(6)))
+    assert all(r.returncode == 0 and r.stdout == "/talker\n" for r in results), [(r.stdout, r.stderr) for r in results]
+    pids = [p for p in os.listdir("/proc") if p.isdigit()]
+    daemons = []
+    for pid in pids:
+        try:
+            cmdline = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
+            environ = Path(f"/proc/{pid}/environ").read_bytes()
+        except OSError:
+            continue
+        if b"roc.ros.daemon" in cmdline and env["XDG_RUNTIME_DIR"].encode() in environ:
+            daemons.append(pid)
+    assert len(daemons) == 1
+
+
+def test_idle_daemon_exits(talker):
+    env = {**talker, "ROC_DAEMON_IDLE_SECONDS": "1"}
+    roc("daemon", "start", env=env)
+    pid = status(env)["pid"]
+    time.sleep(3)
+    assert not Path(f"/proc/{pid}").exists() or b"Z" in Path(f"/proc/{pid}/stat").read_bytes().split()[2]
+    assert roc("daemon", "status", env=env).stdout == "The daemon is not running\n"
+
+
+def test_bad_request_gets_an_error_line(talker):
+    import socket
+
+    env = talker
+    roc("daemon", "start", env=env)
+    sock = socket.socket(socket.AF_UNIX)
+    sock.connect(status(env)["socket"])
+    sock.sendall(b'{"id": 7, "method": "no_such_thing"}\nnot json\n')
+    reader = sock.makefile()
+    first, second = json.loads(reader.readline()), json.loads(reader.readline())
+    sock.close()
+    assert first["id"] == 7 and first["final"] and "no_such_thing" in first["error"]["message"]
+    assert second["final"] and "error" in second
+
+
+def test_no_daemon_is_complete(tmp_path):
+    """Five processes, ten daemon-less runs: every node every time (ros2 misses some in most runs)."""
+    env = graph_env(40, tmp_path)
+    specs = [{"name": f"node{i}", "publishers": [{"topic": f"topic{i}", "type": "std_msgs/msg/String"}]}
+             for i in range(5)]
+    processes = start_nodes(specs, env)
+    try:
+        expected = [f"/node{i}" for i in range(5)]
+        for _ in range(5):
+            got = roc("node", "list", "--no-daemon", env=env)
+            assert got.stdout.splitlines() == expected
+        assert status(env)["running"] is False
+    finally:
+        stop_all(processes)
+
+
+def test_broken_pipe_is_quiet(talker):
+    done = subprocess.run(f"'{BIN / 'roc'}' topic list --no-daemon --spin-time 0.5 | head -0", shell=True,
+                          env=talker, capture_output=True, text=True, timeout=60)
+    assert done.stderr == ""
