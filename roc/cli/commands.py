@@ -24,6 +24,8 @@ COMMANDS = (
     (("work", "cache"), (), "work_cache", "CI caching of build results: cache key | export PATH | import PATH"),
     (("work", "config"), (), "work_config", "print the effective configuration and where each value comes from"),
     (("work", "create"), (), "work_create", "create a new package from a template (like ros2 pkg create)"),
+    (("idl",), (), None, "interface definitions: convert between protobuf and ROS 2 messages"),
+    (("idl", "protobuf"), (), "idl_protobuf", "convert .proto files to .msg files, or .msg files to .proto"),
     (("completion",), (), "completion", "print a shell completion script: bash, zsh or fish"),
 )
 
