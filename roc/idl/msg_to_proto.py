@@ -44,11 +44,19 @@ def parse(path: Path, package: str):
 
 
 def enum_groups(constants: list) -> tuple[dict[str, list], list]:
-    """Integer constants sharing a prefix (all words but the last), two or more, fitting int32 -> enums."""
+    """Integer constants fitting int32 grouped by the longest word prefix (``A_B`` of ``A_B_C``) they share
+    with another one; groups of two or more become enums, the rest stay constants."""
+    integers = [c for c in constants if c.type in INTEGERS and c.value in INT32]
+    prefixes = [["_".join(c.name.split("_")[:k]) for k in range(1, c.name.count("_") + 1)] for c in integers]
+    counts: dict[str, int] = {}
+    for names in prefixes:
+        for prefix in names:
+            counts[prefix] = counts.get(prefix, 0) + 1
     groups: dict[str, list] = {}
-    for const in constants:
-        if const.type in INTEGERS and "_" in const.name and const.value in INT32:
-            groups.setdefault(const.name.rsplit("_", 1)[0], []).append(const)
+    for const, names in zip(integers, prefixes):
+        shared = [p for p in names if counts[p] > 1]
+        if shared:
+            groups.setdefault(shared[-1], []).append(const)
     groups = {prefix: members for prefix, members in groups.items() if len(members) > 1}
     grouped = {id(c) for members in groups.values() for c in members}
     return groups, [c for c in constants if id(c) not in grouped]
@@ -69,6 +77,7 @@ def proto_text(spec, source: str, config: Config) -> tuple[str, set[str]]:
             body.append("    option allow_alias = true;")
         if all(c.value != 0 for c in members):
             body.append(f"    {prefix}_UNSPECIFIED = 0;  // {naming.ADDED_MARK}")
+        members = sorted(members, key=lambda c: c.value != 0)  # proto3: the first value is zero
         body += [f"    {c.name} = {c.value};" for c in members]
         body.append("  }")
     for number, field in enumerate(spec.fields, 1):

@@ -19,19 +19,30 @@ def words(name: str) -> list[str]:
     return [w.lower() for w in re.split(r"[^A-Za-z0-9]+", spaced) if w]
 
 
+MESSAGE = re.compile(r"^[A-Z][A-Za-z0-9]*$")
+FIELD = re.compile(r"^[a-z](_?[a-z0-9]+)*$")
+CONSTANT = re.compile(r"^[A-Z](_?[A-Z0-9]+)*$")
+
+
 def camel(name: str) -> str:
-    """``foo_bar`` -> ``FooBar`` (a valid ROS message name part)."""
+    """``foo_bar`` -> ``FooBar`` (a valid ROS message name part; a valid one is kept)."""
+    if MESSAGE.match(name):
+        return name
     return "".join(w[:1].upper() + w[1:] for w in words(name))
 
 
 def snake(name: str) -> str:
-    """``fooBar`` -> ``foo_bar`` (a valid ROS field name when it starts with a letter)."""
+    """``fooBar`` -> ``foo_bar`` (a valid ROS field name; a valid one is kept)."""
+    if FIELD.match(name):
+        return name
     text = "_".join(words(name))
     return text if text[:1].isalpha() else f"f_{text}"
 
 
 def constant(name: str) -> str:
-    """A ROS constant name: upper case, single underscores, starting with a letter."""
+    """A ROS constant name: upper case, single underscores, starting with a letter (a valid one is kept)."""
+    if CONSTANT.match(name):
+        return name
     text = "_".join(w.upper() for w in words(name))
     return text if text[:1].isalpha() else f"C_{text}"
 
