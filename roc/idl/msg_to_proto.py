@@ -100,7 +100,8 @@ def proto_text(spec, source: str, config: Config) -> tuple[str, set[str]]:
         else:
             proto = SCALARS[ros.type]
         notes = []
-        if ros.array_size or ros.string_upper_bound or (not ros.pkg_name and ros.type not in EXACT):
+        exact = ros.type in EXACT or (proto == "bytes" and not ros.array_size and ros.type == "uint8")
+        if ros.array_size or ros.string_upper_bound or (not ros.pkg_name and not exact):
             notes.append(f"ROS: {ros}")
         if field.default_value is not None:
             notes.append(f"default: {field.default_value}")
