@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from roc.errors import RocError
+from roc.errors import RocError, UsageError
 from roc.render import print_lines
 
 
@@ -19,6 +19,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="import root (repeatable); default: each file's directory")
     parser.add_argument("-c", "--config", type=Path, metavar="FILE",
                         help="YAML with type mappings and renames (keys: types, fields, renames, packages)")
+    parser.add_argument("--ros-package", action="store_true",
+                        help=".proto -> .msg: also write package.xml and CMakeLists.txt, so each package builds")
     parser.add_argument("-v", "--verbose", action="store_true", help="also print each file's content and notes")
     parser.add_argument("-n", "--dry-run", action="store_true", help="print what would be written, write nothing")
 
@@ -58,7 +60,14 @@ def convert(files: list[Path], output: Path, package: str | None, includes: list
 def run(args: argparse.Namespace) -> int:
     from roc.fsutil import write_text_atomic
 
-    outputs, notes = convert([Path(f) for f in args.files], args.output, args.package, args.include, args.config)
+    files = [Path(f) for f in args.files]
+    outputs, notes = convert(files, args.output, args.package, args.include, args.config)
+    if args.ros_package:
+        if direction(files) != ".proto":
+            raise UsageError("--ros-package: only for .proto -> .msg")
+        from roc.idl.package import package_files
+
+        outputs.update(package_files(outputs))
     lines = []
     for relative, text in sorted(outputs.items()):
         target = args.output / relative

@@ -156,8 +156,7 @@ class Converter:
         if proto.type == 8:
             return value
         if proto.type in (1, 2):
-            number = float(value)
-            return "nan" if math.isnan(number) else value
+            return "nan" if math.isnan(float(value)) else value
         if proto.type == 9:
             return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
         if proto.type == TYPE_BYTES:
@@ -211,7 +210,12 @@ class Converter:
                 out.append(f"# {line.rstrip()}".rstrip())
             line = f"{self.field_type(definition, i, helpers)} {name}"
             if proto.HasField("default_value") and f"{definition.full}.{proto.name}" not in self.config.fields:
-                line += f" {self.default(definition, proto)}"
+                value = self.default(definition, proto)
+                if proto.type in (1, 2) and not math.isfinite(float(value)):
+                    # the ROS parsers accept nan/inf, but rosidl's C generator emits code that does not compile
+                    out.append(f"# default: {value} (not finite: rosidl cannot build it)")
+                else:
+                    line += f" {value}"
             out.append(line)
         return "\n".join(out) + "\n"
 
