@@ -176,4 +176,6 @@ def _to_proto_message(field, value, target) -> None:
     elif full == "google.protobuf.Empty":
         target.SetInParent()
     else:
-        target.CopyFrom(to_proto(value, type(target)))
+        converted = to_proto(value, type(target))
+        if converted.ByteSize():  # an all-default ROS message leaves the protobuf field unset
+            target.CopyFrom(converted)
