@@ -16,7 +16,7 @@ def well_known_include() -> str:
     return str(resources.files("grpc_tools") / "_proto")
 
 
-def _run(arguments: list[str]) -> tuple[int, str]:
+def run(arguments: list[str]) -> tuple[int, str]:
     """Run protoc with ``arguments``; its exit code and what it printed (it writes to fd 2 directly)."""
     from grpc_tools import protoc
 
@@ -51,7 +51,7 @@ def descriptor_set(files: list[Path], includes: list[Path]):
         out = Path(temporary) / "set.pb"
         arguments = [f"-I{root}" for root in roots] + [f"-I{well_known_include()}"]
         arguments += [f"--descriptor_set_out={out}", "--include_imports", "--include_source_info"]
-        code, errors = _run(arguments + [str(p.resolve()) for p in files])
+        code, errors = run(arguments + [str(p.resolve()) for p in files])
         if code != 0:
             raise RocError(_first_error(errors) or "protoc failed")
         result = descriptor_pb2.FileDescriptorSet()
@@ -64,7 +64,7 @@ def check(directory: Path, names: list[str], includes: list[Path]) -> None:
     with tempfile.TemporaryDirectory(prefix="roc-idl-") as temporary:
         arguments = [f"-I{directory}"] + [f"-I{p}" for p in includes] + [f"-I{well_known_include()}"]
         arguments += [f"--descriptor_set_out={Path(temporary) / 'set.pb'}"]
-        code, errors = _run(arguments + names)
+        code, errors = run(arguments + names)
         if code != 0:
             raise RocError(f"generated .proto does not compile: {_first_error(errors)}")
 
