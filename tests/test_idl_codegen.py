@@ -1,6 +1,6 @@
 """roc.idl.codegen: a package with protobuf sources (workspaces/fixtures/idl) -> .msg files, roc_idl.cmake and
 protoc's Python modules; the package then builds with rosidl and converts protobuf <-> ROS both ways.
-(Not yet a task of roc work build: the test runs the step and passes ROC_IDL_DIR itself.)"""
+The step runs inside the package's CMake build handler (roc/idl/buildstep.py)."""
 
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ def test_generate_writes_msgs_cmake_and_python(tmp_path):
 CHECK = """
 from robot import state_pb2
 from robot_proto_msgs.msg import State
-from roc.idl.runtime import to_proto, to_ros
+from robot_proto_msgs_protobuf import to_proto, to_ros  # installed with the package
 pb = state_pb2.State(mode=1, waypoint="dock", frames=[b"jpg"])
 pb.pose.x, pb.pose.theta = 1.0, 0.5
 pb.stamp.seconds = 42
@@ -41,14 +41,23 @@ print("converted")
 
 
 @pytest.mark.slow
-def test_generated_package_builds_and_converts(tmp_path):
+def test_roc_work_build_generates_builds_installs_converters_and_rebuilds_on_edit(tmp_path):
     workspace = tmp_path / "ws"
     shutil.copytree(PACKAGE, workspace / "src" / PACKAGE.name)
-    generated = workspace / "build" / "roc_idl" / PACKAGE.name
-    generate(PACKAGE.name, workspace / "src" / PACKAGE.name / "proto", generated)
-    build = roc("work", "build", "--cmake-args", f"-DROC_IDL_DIR={generated}", cwd=workspace, timeout=900)
+    build = roc("work", "build", cwd=workspace, timeout=900)
     assert build.returncode == 0, build.stdout + build.stderr
+    assert "-m roc.idl.codegen robot_proto_msgs" in (workspace / "log" / "latest" / PACKAGE.name / "command.log").read_text()
     (tmp_path / "check.py").write_text(CHECK)
-    run = in_sourced_shell(workspace, f"PYTHONPATH={generated / 'python'}:$PYTHONPATH python {tmp_path / 'check.py'}")
+    run = in_sourced_shell(workspace, f"python {tmp_path / 'check.py'}")
     assert run.returncode == 0, run.stdout + run.stderr
     assert run.stdout.strip() == "converted"
+    # unchanged: skipped (fingerprints); a .proto edited: generated and built again
+    again = roc("work", "build", cwd=workspace, timeout=900)
+    assert again.returncode == 0 and "1 package up to date (not rebuilt): robot_proto_msgs" in again.stdout + again.stderr
+    proto = workspace / "src" / PACKAGE.name / "proto" / "robot" / "types.proto"
+    proto.write_text(proto.read_text().replace("double theta = 3;", "double theta = 3;\n  string frame = 4;"))
+    edited = roc("work", "build", cwd=workspace, timeout=900)
+    assert edited.returncode == 0, edited.stdout + edited.stderr
+    assert "string frame" in (workspace / "build" / PACKAGE.name / "roc_idl" / "msg" / "Pose2D.msg").read_text()
+    run = in_sourced_shell(workspace, "python -c 'from robot_proto_msgs.msg import Pose2D; print(Pose2D().frame == \"\")'")
+    assert run.stdout.strip() == "True", run.stdout + run.stderr
