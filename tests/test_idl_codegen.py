@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from build_helpers import FIXTURES, in_sourced_shell, roc
+from build_helpers import FIXTURES, colcon, in_sourced_shell, roc
 from roc.idl.codegen import generate
 
 PACKAGE = FIXTURES / "idl" / "src" / "robot_proto_msgs"
@@ -61,3 +61,17 @@ def test_roc_work_build_generates_builds_installs_converters_and_rebuilds_on_edi
     assert "string frame" in (workspace / "build" / PACKAGE.name / "roc_idl" / "msg" / "Pose2D.msg").read_text()
     run = in_sourced_shell(workspace, "python -c 'from robot_proto_msgs.msg import Pose2D; print(Pose2D().frame == \"\")'")
     assert run.stdout.strip() == "True", run.stdout + run.stderr
+
+
+@pytest.mark.slow
+@pytest.mark.colcon
+def test_colcon_builds_it_through_the_cmake_fallback(tmp_path):
+    """colcon knows nothing of the marker: the fixture's CMakeLists.txt runs the step at configure time."""
+    workspace = tmp_path / "ws"
+    shutil.copytree(PACKAGE, workspace / "src" / PACKAGE.name)
+    build = colcon("build", cwd=workspace)
+    assert build.returncode == 0, build.stdout + build.stderr
+    run = in_sourced_shell(workspace, "python -c 'import robot_proto_msgs_protobuf, robot.state_pb2; "
+                                      "from robot_proto_msgs.msg import State; print(State.GOAL_WAYPOINT)'",
+                           strict=False)  # colcon's scripts do not run under set -u
+    assert run.stdout.strip() == "2", run.stdout + run.stderr
