@@ -5,7 +5,6 @@ The step runs inside the package's CMake build handler (roc/idl/buildstep.py).""
 from __future__ import annotations
 
 import shutil
-from pathlib import Path
 
 import pytest
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 import codecs
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from roc.errors import RocError
 from roc.idl import naming
