@@ -103,6 +103,12 @@ def build_cmake(context: TaskContext, job: PackageJob, options: BuildOptions) ->
     build_dir = job.build_dir
     build_dir.mkdir(parents=True, exist_ok=True)
     args = cmake_arguments(job, options)
+    from roc.idl.buildstep import command as idl_step
+
+    idl = idl_step(job.package.name, job.source, build_dir)
+    if idl is not None:  # protobuf sources: .msg files generated into the build directory first
+        _check(context, job, idl[0], "code generation (roc idl)")
+        args.append(idl[1])
     last_args = build_dir / "cmake_args.last"
     recorded = repr(args) if args else "None"
     if options.cmake_clean_cache:

@@ -55,6 +55,8 @@ COMMANDS = (
     (("daemon", "start"), (), "daemon_start", "start the roc daemon of this discovery environment"),
     (("daemon", "stop"), (), "daemon_stop", "stop the roc daemon of this discovery environment"),
     (("daemon", "status"), (), "daemon_status", "whether the roc daemon of this environment runs"),
+    (("idl",), (), None, "interface definitions: convert between protobuf and ROS 2 messages"),
+    (("idl", "protobuf"), (), "idl_protobuf", "convert .proto files to .msg files, or .msg files to .proto"),
     (("completion",), (), "completion", "print a shell completion script: bash, zsh or fish"),
 )
 
