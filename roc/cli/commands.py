@@ -34,7 +34,7 @@ COMMANDS = (
 
 
 # Verbs whose options roc.toml and colcon's defaults files can set.
-CONFIGURED_VERBS = ("list", "info", "graph", "build", "env", "cache")
+CONFIGURED_VERBS = ("list", "info", "graph", "build", "test", "env", "cache")
 
 
 class Parser(argparse.ArgumentParser):

@@ -129,7 +129,7 @@ def _handlers(args, switches: dict[str, bool], root: Path, build_base: Path) -> 
 def run(args: argparse.Namespace) -> int:
     from roc.builder.layout import prepare_build_base, prepare_install_base
     from roc.builder.lock import build_lock
-    from roc.commands.work_build import _event_handler_switches
+    from roc.commands.work_build import _event_handler_switches, skip_configured_packages
     from roc.engine.executor import execute
     from roc.engine.store import DurationStore
     from roc.testing.plan import plan_tests
@@ -143,6 +143,7 @@ def run(args: argparse.Namespace) -> int:
     if args.retest_until_fail < 0 or args.retest_until_pass < 0:
         raise UsageError("--retest-until-fail/--retest-until-pass must be 0 or more")
     workspace = load_workspace(args)
+    skip_configured_packages(args, workspace)
     _skip_untestable(workspace)
     options = _options(args, workspace.root)
     workers = 1 if args.executor == "sequential" else args.parallel_workers
