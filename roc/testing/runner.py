@@ -137,6 +137,18 @@ def _posix(path: Path) -> str:
     return str(PurePosixPath(*path.parts))
 
 
+def _plugin(package: str, module: str, option: str) -> bool:
+    """Whether the pytest plugin an option needs is installed (else the option is ignored, as in colcon)."""
+    import importlib.util
+
+    from roc.messages import warn
+
+    if importlib.util.find_spec(module) is None:
+        warn(f"ignored {option} for '{package}': the pytest plugin '{module}' is not installed")
+        return False
+    return True
+
+
 def pytest_addopts(name: str, source: Path, options: TestOptions) -> tuple[list[str], dict[str, str]]:
     """colcon's pytest arguments (passed in PYTEST_ADDOPTS) and extra environment."""
     build_dir = options.build_base / name
@@ -147,9 +159,9 @@ def pytest_addopts(name: str, source: Path, options: TestOptions) -> tuple[list[
         args += [f"--cov={_posix(source)}", f"--cov-report=html:{_posix(build_dir / 'coverage.html')}",
                  f"--cov-report=xml:{_posix(build_dir / 'coverage.xml')}", "--cov-branch"]
         env["COVERAGE_FILE"] = str(build_dir / ".coverage")
-    if options.retest_until_fail:
+    if options.retest_until_fail and _plugin(name, "pytest_repeat", "--retest-until-fail"):
         args.append(f"--count={options.retest_until_fail + 1}")
-    if options.retest_until_pass:
+    if options.retest_until_pass and _plugin(name, "pytest_rerunfailures", "--retest-until-pass"):
         args.append(f"--reruns={options.retest_until_pass}")
     args += options.pytest_args or ()
     return args, env
