@@ -26,7 +26,7 @@ def read_test_state(build_dir: Path) -> dict:
     return state if isinstance(state, dict) and isinstance(state.get("files", {}), dict) else {}
 
 
-def test_key(source: Path, build_base: Path, name: str, dependencies: list[str], options: dict,
+def results_key(source: Path, build_base: Path, name: str, dependencies: list[str], options: dict,
              previous: dict) -> tuple[str | None, dict]:
     """The key of a test run and the new file stamps; None when the build is not roc's (no fingerprint
     of what is built, so nothing to vouch for a cached result)."""

@@ -8,9 +8,9 @@ from roc.builder.plan import build_environment
 from roc.buildtypes.context import BuildOptions
 from roc.engine.process import TaskContext
 from roc.engine.ready import Task
-from roc.testing.cache import passed_before, read_test_state, test_key, write_test_state
+from roc.testing.cache import passed_before, read_test_state, results_key, write_test_state
 from roc.testing.results import collect_results
-from roc.testing.runner import TestOptions, test_package
+from roc.testing.runner import TestOptions, run_package_tests
 from roc.workspace.dependencies import recursive_dependencies
 from roc.workspace.load import Workspace
 from roc.workspace.package import Package
@@ -30,7 +30,7 @@ def plan_tests(workspace: Workspace, options: TestOptions, weights: dict[str, fl
         key, files, cached = None, {}, False
         if use_cache:
             state = read_test_state(options.build_base / package.name)
-            key, files = test_key(source, options.build_base, package.name, dependencies, options.digest(), state)
+            key, files = results_key(source, options.build_base, package.name, dependencies, options.digest(), state)
             cached = not force and passed_before(state, key)
         tasks.append(Task(
             name=package.name,
@@ -55,7 +55,7 @@ def _test_action(package: Package, source: Path, dependencies: list[str], option
         build_dir.mkdir(parents=True, exist_ok=True)
         if use_cache:
             write_test_state(build_dir, None, False, files, [])
-        passed = test_package(context, package.type, package.name, source, env, options)
+        passed = run_package_tests(context, package.type, package.name, source, env, options)
         if use_cache:
             results: set[str] = set()
             collect_results(options.result_dir(package.name), files=results)

@@ -57,7 +57,7 @@ def testable(package_type: str) -> bool:
     return package_type in CMAKE_TYPES + PYTHON_TYPES
 
 
-def test_package(context: TaskContext, package_type: str, name: str, source: Path, env: dict[str, str],
+def run_package_tests(context: TaskContext, package_type: str, name: str, source: Path, env: dict[str, str],
                  options: TestOptions) -> bool:
     """Run the package's tests; True when all passed (or there were none)."""
     if package_type in CMAKE_TYPES:
