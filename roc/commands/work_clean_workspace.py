@@ -7,6 +7,7 @@ import os
 from pathlib import Path
 
 from roc.builder.clean import BASES
+from roc.errors import UsageError
 from roc.render import print_lines
 
 
@@ -35,8 +36,6 @@ def run(args: argparse.Namespace) -> int:
         if base is None:
             continue
         if base.resolve() == root.resolve() or base.resolve() in root.resolve().parents:
-            from roc.errors import UsageError
-
             raise UsageError(f"the {name} base '{base}' is the workspace or contains it; refusing to remove it")
         if base.exists() or base.is_symlink():
             paths.add(base)
