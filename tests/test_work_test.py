@@ -51,6 +51,7 @@ def test_results_equal_colcon_and_are_cached(tmp_path: Path) -> None:
     actual = roc("work", "test", "--force", cwd=workspace)
     assert actual.returncode == 0, actual.stdout + actual.stderr
     assert "3 packages had test failures: t_cmake_pytest t_plain t_py" in actual.stdout
+    assert "Finished <<< t_plain [" in actual.stdout and "]\t[ with test failures ]\n" in actual.stdout
     assert _results(colcon, workspace) == colcon_results
     assert _results(roc, workspace) == colcon_results
     assert _rc_files(workspace) == colcon_rc
@@ -66,7 +67,7 @@ def test_results_equal_colcon_and_are_cached(tmp_path: Path) -> None:
     passing = roc("work", "test", "t_gtest", "t_notests", "--output", "json", cwd=workspace)
     assert _commands_by_package(passing.stdout) == set()
     text = roc("work", "test", "t_gtest", cwd=workspace)
-    assert "1 package up to date" in text.stdout or "cached" in text.stdout
+    assert "1 package cached (passed before, not tested again): t_gtest" in text.stdout
     # Editing a test reruns that package; --force reruns everything.
     test_source = workspace / "src" / "t_gtest" / "test" / "test_math.cpp"
     test_source.write_text(test_source.read_text() + "// edited\n")

@@ -100,7 +100,7 @@ def _skip_untestable(workspace) -> None:
             workspace.selected.discard(package.name)
 
 
-def _handlers(args, switches: dict[str, bool], root: Path, build_base: Path) -> list:
+def _handlers(args, switches: dict[str, bool], root: Path, results: TestResults) -> list:
     from roc.handlers.console import ConsoleHandler
     from roc.handlers.logs import JsonEventsHandler, LogHandler, new_log_directory
 
@@ -121,7 +121,8 @@ def _handlers(args, switches: dict[str, bool], root: Path, build_base: Path) -> 
             start_end=switches.get("console_start_end", True), stderr=switches.get("console_stderr", True),
             summary=switches.get("summary", True), direct=switches.get("console_direct", False),
             cohesion=switches.get("console_cohesion", False), log_path=str(log_dir) if log_dir else None,
-            status=status,
+            status=status, cached_label="cached (passed before, not tested again)",
+            finished_note=lambda name: "\t[ with test failures ]" if name in results.failures else "",
         ))
     return handlers
 
@@ -153,7 +154,7 @@ def run(args: argparse.Namespace) -> int:
         durations = DurationStore(options.build_base / DURATIONS_FILE)
         results = TestResults(options.build_base, store=switches.get("store_result", True),
                               summary=args.output == "text" and switches.get("summary", True))
-        handlers = [*_handlers(args, switches, workspace.root, options.build_base), results, durations]
+        handlers = [*_handlers(args, switches, workspace.root, results), results, durations]
         try:
             tasks = plan_tests(workspace, options, durations.durations, force=args.force, use_cache=not args.no_cache)
             result = execute(tasks, handlers, workers, continue_on_error=not args.abort_on_error)
