@@ -27,7 +27,7 @@ from pathlib import Path
 
 from roc.errors import UsageError
 
-VERBS = ("list", "info", "graph", "build", "env", "cache", "create")
+VERBS = ("list", "info", "graph", "build", "test", "env", "cache", "create")
 PACKAGE_KEYS = {"cmake-args": list, "ament-cmake-args": list, "skip": bool}
 ROC_TOML = "roc.toml"
 # Options naming a directory: a relative value in roc.toml or colcon_defaults.yaml is taken from that

@@ -20,6 +20,11 @@ COMMANDS = (
     (("work", "info"), (), "work_info", "show package details (like colcon info)"),
     (("work", "graph"), (), "work_graph", "show the dependency graph (like colcon graph)"),
     (("work", "build"), ("b",), "work_build", "build the workspace (a drop-in for colcon build)"),
+    (("work", "test"), ("t",), "work_test", "test the workspace's packages (a drop-in for colcon test)"),
+    (("work", "test-result"), (), "work_test_result", "summarize the test results (like colcon test-result)"),
+    (("work", "clean"), (), None, "remove build, install, log and test result directories (like colcon clean)"),
+    (("work", "clean", "workspace"), (), "work_clean_workspace", "clean the whole workspace's bases"),
+    (("work", "clean", "packages"), (), "work_clean_packages", "clean the selected packages' directories"),
     (("work", "env"), (), "work_env", "print a package's build environment, or run a command in it"),
     (("work", "cache"), (), "work_cache", "CI caching of build results: cache key | export PATH | import PATH"),
     (("work", "config"), (), "work_config", "print the effective configuration and where each value comes from"),
@@ -62,7 +67,7 @@ COMMANDS = (
 
 
 # Verbs whose options roc.toml and colcon's defaults files can set.
-CONFIGURED_VERBS = ("list", "info", "graph", "build", "env", "cache")
+CONFIGURED_VERBS = ("list", "info", "graph", "build", "test", "env", "cache")
 
 
 # colcon options (from extensions roc does not replace) that roc does not have, and what to do instead.

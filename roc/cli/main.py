@@ -84,7 +84,9 @@ def main(argv: list[str] | None = None) -> int:
         config = None
         if path in parser.leaves and path[0] == "work" and path[-1] in CONFIGURED_VERBS:
             config = _apply_workspace_configuration(parser, path, argv)
-        if any(token in argv for token in ("--cmake-args", "--ament-cmake-args")):
+        from roc.cli.options import PASSTHROUGH_OPTIONS
+
+        if any(token in argv for token in PASSTHROUGH_OPTIONS):
             from roc.cli.options import rewrite_passthrough
             from roc.commands.completion import all_options
 

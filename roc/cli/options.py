@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 
 # Options whose values are passed through to a tool and may themselves start with a dash.
-PASSTHROUGH_OPTIONS = ("--cmake-args", "--ament-cmake-args")
+PASSTHROUGH_OPTIONS = ("--cmake-args", "--ament-cmake-args", "--ctest-args", "--pytest-args")
 
 
 def add_format_argument(parser: argparse.ArgumentParser, formats: tuple[str, ...] = ("text", "json")) -> None:
@@ -14,8 +14,9 @@ def add_format_argument(parser: argparse.ArgumentParser, formats: tuple[str, ...
                         help="output format (default: text); json is stable for scripts")
 
 
-def add_selection_arguments(parser: argparse.ArgumentParser) -> None:
-    """Discovery and selection options, as in colcon (``--packages-start``/``-end`` spelled as colcon 0.21)."""
+def add_selection_arguments(parser: argparse.ArgumentParser, previous_test: bool = False) -> None:
+    """Discovery and selection options, as in colcon (``--packages-start``/``-end`` spelled as colcon 0.21);
+    ``previous_test`` adds the options that select by the last test result (roc work test)."""
     discovery = parser.add_argument_group("discovery")
     discovery.add_argument("--base-paths", nargs="*", metavar="PATH",
                            help="base paths to crawl recursively for packages (default: the workspace root)")
@@ -46,6 +47,11 @@ def add_selection_arguments(parser: argparse.ArgumentParser) -> None:
                           help="only packages whose last build failed (aborted ones are not failures)")
     previous.add_argument("--packages-skip-build-finished", action="store_true",
                           help="skip packages whose last build finished successfully")
+    if previous_test:
+        previous.add_argument("--packages-select-test-failures", action="store_true",
+                              help="only packages whose last test run had failures or errors")
+        previous.add_argument("--packages-skip-test-passed", action="store_true",
+                              help="skip packages whose last test run passed")
     add("--packages-select", nargs="*", metavar="PKG_NAME", help="only these packages")
     add("--packages-skip", nargs="*", metavar="PKG_NAME", help="skip these packages")
     add("--packages-select-regex", nargs="*", metavar="PATTERN", help="only packages whose name matches a pattern")

@@ -41,8 +41,11 @@ class ConsoleHandler:
 
     def __init__(self, stream: TextIO = sys.stdout, *, start_end: bool = True, stderr: bool = True,
                  summary: bool = True, direct: bool = False, cohesion: bool = False, log_path: str | None = None,
-                 status=None, kind: str = "build"):
+                 status=None, kind: str = "build", cached_label: str = "up to date (not rebuilt)",
+                 finished_note=None):
         self.stream = stream
+        self.cached_label = cached_label  # how the summary names tasks that finished without running
+        self.finished_note = finished_note  # (task) -> text appended to its "Finished" line
         self.status = status  # a StatusLine on a terminal: lines are printed above it
         self.start_end, self.stderr, self.summary = start_end, stderr, summary
         self.direct, self.cohesion = direct, cohesion
@@ -105,6 +108,8 @@ class ConsoleHandler:
         if isinstance(event, TaskFinished):
             (self.cached if event.cached else self.finished).append(name)
             line = f"Finished <<< {name} [{'cached' if event.cached else format_duration(event.duration)}]"
+            if self.finished_note:
+                line += self.finished_note(name)
         elif isinstance(event, TaskFailed):
             self.failed.append(name)
             reason = event.reason.strip().splitlines()[-1] if event.reason.strip() else "failed"
@@ -121,7 +126,7 @@ class ConsoleHandler:
         lines = ["", f"Summary: {_count(len(self.finished) + len(self.cached))} finished [{total}]"]
         if self.cached:
             names = f": {' '.join(sorted(self.cached))}" if len(self.cached) <= 10 else ""
-            lines.append(f"  {_count(len(self.cached))} up to date (not rebuilt){names}")
+            lines.append(f"  {_count(len(self.cached))} {self.cached_label}{names}")
         if self.failed:
             lines.append(f"  {_count(len(self.failed))} failed: {' '.join(sorted(self.failed))}")
         if self.aborted:

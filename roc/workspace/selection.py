@@ -104,7 +104,8 @@ def select_packages(args: argparse.Namespace, ordered: list[Package], build_base
         selected -= {p.name for p in ordered if unwanted & deps_of(p.name).keys()}
     if args.packages_skip_up_to:
         selected -= up_to(set(args.packages_skip_up_to))
-    if args.packages_select_build_failed or args.packages_skip_build_finished:
+    if (args.packages_select_build_failed or args.packages_skip_build_finished
+            or getattr(args, "packages_select_test_failures", False) or getattr(args, "packages_skip_test_passed", False)):
         selected &= _by_previous_result(args, ordered, build_base or Path("build"))
     if args.packages_select is not None or args.packages_select_regex is not None:
         chosen = set(args.packages_select or [])
@@ -128,18 +129,21 @@ def _in_range(args: argparse.Namespace, ordered: list[Package]) -> set[str]:
     return set(names[start:end + 1])
 
 
-def previous_build_result(build_base: Path, name: str) -> str | None:
-    """The result colcon (and roc) stored for the last build of ``name``: '0' for success."""
+def previous_build_result(build_base: Path, name: str, verb: str = "build") -> str | None:
+    """The result colcon (and roc) stored for the last build (or test) of ``name``: '0' for success."""
     try:
-        return (build_base / name / "colcon_build.rc").read_text().strip()
+        return (build_base / name / f"colcon_{verb}.rc").read_text().strip()
     except OSError:
         return None
 
 
 def _by_previous_result(args: argparse.Namespace, ordered: list[Package], build_base: Path) -> set[str]:
+    """--packages-select-build-failed, --packages-skip-build-finished and their test counterparts."""
     keep: Callable[[str | None], bool]
-    if args.packages_select_build_failed:
+    select_failed = args.packages_select_build_failed or getattr(args, "packages_select_test_failures", False)
+    verb = "build" if args.packages_select_build_failed or args.packages_skip_build_finished else "test"
+    if select_failed:
         keep = lambda result: result not in (None, "0", INTERRUPTED_RESULT)  # noqa: E731
     else:
         keep = lambda result: result != "0"  # noqa: E731
-    return {p.name for p in ordered if keep(previous_build_result(build_base, p.name))}
+    return {p.name for p in ordered if keep(previous_build_result(build_base, p.name, verb))}

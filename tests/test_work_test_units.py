@@ -1,0 +1,67 @@
+"""Fast checks of ``roc work test``'s pieces: colcon's pytest arguments, cached-result keys, selection by
+the last test result."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from roc.cli.options import add_selection_arguments
+from roc.testing.cache import passed_before, read_test_state, results_key, write_test_state
+from roc.testing.runner import TestOptions, pytest_addopts
+from roc.workspace.package import Package
+from roc.workspace.selection import select_packages
+
+
+def test_pytest_arguments_are_colcons(tmp_path: Path) -> None:
+    options = TestOptions(build_base=Path("/ws/build"), install_base=Path("/ws/install"),
+                          pytest_args=("-k", "double"), retest_until_pass=2)
+    args, env = pytest_addopts("pkg", Path("/ws/src/pkg"), options)
+    assert args == ["--tb=short", "--junit-xml=/ws/build/pkg/pytest.xml", "--junit-prefix=pkg",
+                    "-o", "cache_dir=/ws/build/pkg/.pytest_cache", "--reruns=2", "-k", "double"]
+    assert env == {}
+    results = TestOptions(build_base=Path("/ws/build"), install_base=Path("/ws/install"),
+                          test_result_base=Path("/ws/results"), pytest_with_coverage=True)
+    args, env = pytest_addopts("pkg", Path("/ws/src/pkg"), results)
+    assert args[1] == "--junit-xml=/ws/results/pkg/pytest.xml"
+    assert args[5:] == ["--cov=/ws/src/pkg", "--cov-report=html:/ws/build/pkg/coverage.html",
+                        "--cov-report=xml:/ws/build/pkg/coverage.xml", "--cov-branch"]
+    assert env == {"COVERAGE_FILE": "/ws/build/pkg/.coverage"}
+
+
+def test_cached_result_needs_the_same_key_a_pass_and_the_result_files(tmp_path: Path) -> None:
+    source, build = tmp_path / "src" / "pkg", tmp_path / "build"
+    source.mkdir(parents=True)
+    (source / "test_it.py").write_text("def test_ok(): pass\n")
+    (build / "pkg").mkdir(parents=True)
+    assert results_key(source, build, "pkg", [], {}, {})[0] is None  # not built by roc: never cached
+    (build / "pkg" / "roc_state.json").write_text('{"fingerprint": "f1", "files": {}}')
+    key, files = results_key(source, build, "pkg", [], {}, {})
+    result = build / "pkg" / "pytest.xml"
+    result.write_text("<testsuite tests='1' failures='0'/>")
+    write_test_state(build / "pkg", key, True, files, [str(result)])
+    state = read_test_state(build / "pkg")
+    assert passed_before(state, key)
+    assert not passed_before(state, results_key(source, build, "pkg", [], {"pytest": ["-x"]}, state)[0])
+    (source / "test_it.py").write_text("def test_ok(): assert True\n")
+    assert not passed_before(state, results_key(source, build, "pkg", [], {}, state)[0])
+    (source / "test_it.py").write_text("def test_ok(): pass\n")
+    assert passed_before(state, results_key(source, build, "pkg", [], {}, state)[0])
+    result.unlink()
+    assert not passed_before(state, key)
+    write_test_state(build / "pkg", key, False, files, [])
+    assert not passed_before(read_test_state(build / "pkg"), key)
+
+
+def test_selection_by_the_last_test_result(tmp_path: Path) -> None:
+    packages = [Package(name=name, path=Path("src", name), type="ros.ament_cmake", dependencies={})
+                for name in ("failed", "passed", "aborted", "untested")]
+    for name, text in (("failed", "test failures\n"), ("passed", "0\n"), ("aborted", "SIGINT\n")):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "colcon_test.rc").write_text(text)
+    parser = argparse.ArgumentParser()
+    add_selection_arguments(parser, previous_test=True)
+    failures = parser.parse_args(["--packages-select-test-failures"])
+    assert select_packages(failures, packages, tmp_path) == {"failed"}
+    not_passed = parser.parse_args(["--packages-skip-test-passed"])
+    assert select_packages(not_passed, packages, tmp_path) == {"failed", "aborted", "untested"}
