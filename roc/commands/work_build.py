@@ -9,12 +9,8 @@ from pathlib import Path
 
 from roc.cli.options import add_layout_arguments, add_selection_arguments
 from roc.errors import EXIT_FAILURE, EXIT_INTERRUPTED, UsageError
+from roc.handlers import add_event_handlers_argument, handler_switches, output_handlers
 
-# colcon event handlers roc has, and the ones it accepts only when disabled.
-EVENT_HANDLERS = {"console_start_end", "console_stderr", "console_direct", "console_cohesion", "summary",
-                  "status", "log", "event_log", "store_result", "log_command"}
-NOT_SUPPORTED_HANDLERS = {"compile_commands", "desktop_notification", "terminal_title", "console_package_list",
-                          "parallel_status"}
 NOT_SUPPORTED_OPTIONS = ("test_result_base", "catkin_cmake_args",
                          "catkin_skip_building_tests")
 DURATIONS_FILE = "roc_durations.json"
@@ -33,10 +29,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="packages built at once, 0 for no limit (default: the number of CPUs)")
     add("-j", "--jobs", type=int, metavar="N",
         help="compiler jobs of all packages together (default: -j of MAKEFLAGS, else the number of CPUs)")
-    handlers = add("--event-handlers", nargs="*", metavar="NAME+/-", default=[],
-                   help="enable (+) or disable (-) output: console_start_end, console_stderr, console_direct, "
-                        "console_cohesion, summary, status, log, event_log, store_result")
-    handlers.completion = [f"{name}{sign}" for name in sorted(EVENT_HANDLERS) for sign in "+-"]
+    add_event_handlers_argument(parser)
     add("--output", choices=("text", "json"), default="text", help="json: one JSON event per line on stdout")
     add("--allow-overriding", action="extend", nargs="+", default=[], metavar="PKG_NAME",
         help="build these packages without the warning that an underlay workspace has them too")
@@ -106,21 +99,6 @@ def warn_about_overrides(args: argparse.Namespace, workspace, install_base: Path
         warn(override_warning(overridden))
 
 
-def _event_handler_switches(values: list[str]) -> dict[str, bool]:
-    switches: dict[str, bool] = {}
-    for value in values:
-        name, sign = value[:-1], value[-1:]
-        if sign not in "+-" or not name:
-            raise UsageError(f"--event-handlers: '{value}' must be a name followed by + or -")
-        if name in NOT_SUPPORTED_HANDLERS and sign == "+":
-            raise UsageError(f"--event-handlers: roc does not support '{name}' yet")
-        if name not in EVENT_HANDLERS | NOT_SUPPORTED_HANDLERS:
-            raise UsageError(f"--event-handlers: unknown handler '{name}'; "
-                             f"known: {', '.join(sorted(EVENT_HANDLERS))}")
-        switches[name] = sign == "+"
-    return switches
-
-
 def _check_supported(args: argparse.Namespace) -> None:
     for option in NOT_SUPPORTED_OPTIONS:
         if getattr(args, option) not in (None, False):
@@ -132,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
     from roc.workspace.load import load_workspace
 
     _check_supported(args)
-    switches = _event_handler_switches(args.event_handlers)
+    switches = handler_switches(args.event_handlers)
     if args.packages:
         args.packages_up_to = [*(args.packages_up_to or []), *args.packages]
     if args.parallel_workers < 0:
@@ -162,40 +140,6 @@ def run(args: argparse.Namespace) -> int:
         return _build(args, workspace, options, switches)
 
 
-def _output_handlers(args, switches: dict[str, bool], root: Path, build_base: Path) -> list:
-    """Where events go: logs, stored results, and the console (or JSON events)."""
-    from roc.handlers.console import ConsoleHandler
-    from roc.handlers.logs import (
-        JsonEventsHandler,
-        LogHandler,
-        ResultStore,
-        new_log_directory,
-    )
-
-    handlers: list = []
-    log_dir = None
-    if args.log_base != os.devnull and switches.get("log", True):
-        log_dir = new_log_directory((root / args.log_base).absolute())
-        handlers.append(LogHandler(log_dir, events=switches.get("event_log", True)))
-    if switches.get("store_result", True):
-        handlers.append(ResultStore(build_base))
-    if args.output == "json":
-        handlers.append(JsonEventsHandler(sys.stdout))
-    else:
-        status = None
-        if switches.get("status", True) and sys.stdout.isatty() and not os.environ.get("NO_COLOR"):
-            from roc.handlers.status import StatusLine
-
-            status = StatusLine()
-        handlers.append(ConsoleHandler(
-            start_end=switches.get("console_start_end", True), stderr=switches.get("console_stderr", True),
-            summary=switches.get("summary", True), direct=switches.get("console_direct", False),
-            cohesion=switches.get("console_cohesion", False), log_path=str(log_dir) if log_dir else None,
-            status=status,
-        ))
-    return handlers
-
-
 def _build(args, workspace, options, switches: dict[str, bool]) -> int:
     from roc.builder.layout import refresh_install_scripts
     from roc.builder.plan import plan_build
@@ -206,7 +150,7 @@ def _build(args, workspace, options, switches: dict[str, bool]) -> int:
     workers = 1 if args.executor == "sequential" else args.parallel_workers
     durations = DurationStore(options.build_base / DURATIONS_FILE)
     jobserver = Jobserver(options.jobs)
-    handlers = [*_output_handlers(args, switches, workspace.root, options.build_base), durations]
+    handlers = [*output_handlers(args, switches, workspace.root, options.build_base), durations]
     try:
         tasks = plan_build(workspace, options, jobserver, durations.durations)
         result = execute(tasks, handlers, workers, continue_on_error=args.continue_on_error)

@@ -130,13 +130,14 @@ def _handlers(args, switches: dict[str, bool], root: Path, results: TestResults)
 def run(args: argparse.Namespace) -> int:
     from roc.builder.layout import prepare_build_base, prepare_install_base
     from roc.builder.lock import build_lock
-    from roc.commands.work_build import _event_handler_switches, skip_configured_packages
+    from roc.commands.work_build import skip_configured_packages
+    from roc.handlers import handler_switches
     from roc.engine.executor import execute
     from roc.engine.store import DurationStore
     from roc.testing.plan import plan_tests
     from roc.workspace.load import load_workspace
 
-    switches = _event_handler_switches(args.event_handlers)
+    switches = handler_switches(args.event_handlers)
     if args.packages:
         args.packages_select = [*(args.packages_select or []), *args.packages]
     if args.parallel_workers < 0:

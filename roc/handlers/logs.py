@@ -61,11 +61,13 @@ def task_log_folder(event: Event, run_kind: str) -> str:
 
 
 class LogHandler:
-    """Per-package logs, and (unless ``event_log-``) every event in ``events.log``."""
+    """Per-package logs (commands in command.log unless ``log_command-``), and (unless ``event_log-``)
+    every event in ``events.log``."""
 
-    def __init__(self, directory: Path, events: bool = True, kind: str = "build"):
+    def __init__(self, directory: Path, events: bool = True, commands: bool = True, kind: str = "build"):
         self.directory = directory
         self.kind = kind
+        self.commands = commands
         self._events = open(directory / "events.log", "a", buffering=1) if events else None
         self._files: dict[tuple[str, str], object] = {}
 
@@ -87,11 +89,11 @@ class LogHandler:
             self._file(event, f"{event.stream}.log").write(event.data)
             self._file(event, "stdout_stderr.log").write(event.data)
             self._file(event, "streams.log").write(event.data)
-        elif isinstance(event, CommandStarted):
+        elif isinstance(event, CommandStarted) and self.commands:
             text = f"Invoking command in '{event.cwd}': {shlex.join(event.command)}\n".encode()
             self._file(event, "command.log").write(text)
             self._file(event, "streams.log").write(text)
-        elif isinstance(event, CommandEnded):
+        elif isinstance(event, CommandEnded) and self.commands:
             text = f"Invoked command '{shlex.join(event.command)}' returned '{event.returncode}'\n".encode()
             self._file(event, "command.log").write(text)
             self._file(event, "streams.log").write(text)

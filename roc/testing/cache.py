@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from roc.builder.fingerprint import combine, source_digest
+from roc.builder.fingerprint import combine, source_parts, source_stamps
 from roc.builder.state import read_state
 from roc.fsutil import write_text_atomic
 from roc.messages import warn
@@ -31,7 +31,8 @@ def results_key(source: Path, build_base: Path, name: str, dependencies: list[st
     """The key of a test run and the new file stamps; None when the build is not roc's (no fingerprint
     of what is built, so nothing to vouch for a cached result)."""
     fingerprint = read_state(build_base / name).get("fingerprint")
-    sources, files = source_digest(source, previous.get("files", {}))
+    files = source_stamps(source, previous.get("files", {}))
+    sources = source_parts(files)
     if not fingerprint:
         return None, files
     key = combine({"build": fingerprint, "sources": sources, "options": options,
