@@ -34,6 +34,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add("--allow-overriding", action="extend", nargs="+", default=[], metavar="PKG_NAME",
         help="build these packages without the warning that an underlay workspace has them too")
     add("--force", action="store_true", help="rebuild the selected packages even when they are up to date")
+    add("--explain", action="store_true",
+        help="build nothing: print each selected package, in build order, and why it would be built")
     add("--no-cache", action="store_true",
         help="neither skip up-to-date packages nor record fingerprints for the next build")
     cmake = parser.add_argument_group("cmake and ament_cmake packages")
@@ -99,6 +101,18 @@ def warn_about_overrides(args: argparse.Namespace, workspace, install_base: Path
         warn(override_warning(overridden))
 
 
+def _explain(args: argparse.Namespace, workspace, options) -> int:
+    from roc.builder.uptodate import explain
+    from roc.render import print_json, print_lines
+
+    explained = explain(workspace, options)
+    if args.output == "json":
+        print_json([{"package": name, "reasons": reasons} for name, reasons in explained])
+    else:
+        print_lines([f"{name}: {'; '.join(reasons) or 'up to date'}" for name, reasons in explained])
+    return 0
+
+
 def _check_supported(args: argparse.Namespace) -> None:
     for option in NOT_SUPPORTED_OPTIONS:
         if getattr(args, option) not in (None, False):
@@ -133,6 +147,8 @@ def run(args: argparse.Namespace) -> int:
         force=args.force,
         use_state=not args.no_cache,
     )
+    if args.explain:
+        return _explain(args, workspace, options)
     warn_about_overrides(args, workspace, options.install_base)
     with build_lock(options.build_base):
         prepare_build_base(options.build_base)
