@@ -26,6 +26,7 @@ import re
 from pathlib import Path
 
 from roc.errors import UsageError
+from roc.messages import did_you_mean, unknown_package
 
 VERBS = ("list", "info", "graph", "build", "test", "env", "cache", "create")
 PACKAGE_KEYS = {"cmake-args": list, "ament-cmake-args": list, "skip": bool}
@@ -92,10 +93,8 @@ class Configuration:
 
 def _closest(word: str, candidates) -> str:
     """``did you mean 'X'? `` for the closest of ``candidates``, else nothing."""
-    import difflib
-
-    close = difflib.get_close_matches(word, list(candidates), n=1, cutoff=0.6)
-    return f"did you mean '{close[0]}'? " if close else ""
+    hint = did_you_mean(word, candidates, count=1)
+    return f"{hint} " if hint else ""
 
 
 def check_package_tables(config: Configuration, names: set[str]) -> None:
@@ -103,8 +102,7 @@ def check_package_tables(config: Configuration, names: set[str]) -> None:
     otherwise be ignored without a word)."""
     for name, (path, line) in config.package_tables.items():
         if name not in names:
-            raise ConfigError(path, f"[package.{name}]", f"no package named '{name}' in the workspace; "
-                              f"{_closest(name, names)}see 'roc work list -n'", line)
+            raise ConfigError(path, f"[package.{name}]", unknown_package(name, names), line)
 
 
 def _dest(key: str) -> str:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from collections.abc import Iterable
 
 emitted: list[str] = []
 
@@ -10,3 +11,18 @@ emitted: list[str] = []
 def warn(message: str) -> None:
     emitted.append(message)
     print(f"roc: warning: {message}", file=sys.stderr)
+
+
+def did_you_mean(word: str, choices: Iterable[str], count: int = 3, quote: bool = True) -> str:
+    """``did you mean 'a' or 'b'?`` for the choices closest to a misspelled ``word``, or ''."""
+    import difflib
+
+    close = difflib.get_close_matches(word, sorted(choices), n=count, cutoff=0.6)
+    names = [f"'{name}'" if quote else name for name in close]
+    return f"did you mean {' or '.join(names)}?" if names else ""
+
+
+def unknown_package(name: str, names: Iterable[str]) -> str:
+    """The one message for a package name the workspace does not have, with the closest names."""
+    hint = did_you_mean(name, names, quote=False) or "run 'roc work list -n' to see the package names"
+    return f"no package named '{name}' in the workspace; {hint}"

@@ -176,7 +176,7 @@ def test_configured_directories_are_relative_to_roc_toml(tmp_path: Path, monkeyp
 
 @pytest.mark.parametrize("toml, message", [
     ('[package.cor]\ncmake-args = ["-DX=1"]\n',
-     "roc.toml:1: '[package.cor]': no package named 'cor' in the workspace; did you mean 'core'?"),
+     "roc.toml:1: '[package.cor]': no package named 'cor' in the workspace; did you mean core?"),
     ('[build]\n\n[ package."lib_c" ]\n', "roc.toml:3: '[package.lib_c]': no package named 'lib_c'"),
     ("[list]\nbase-paths = [\"src\"\n", "roc.toml:2:20: invalid TOML: Unclosed array (at the end of the file)"),
     ("[list]\nbase-paths = \n", "roc.toml:2:14: invalid TOML: Invalid value"),

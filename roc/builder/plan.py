@@ -16,7 +16,6 @@ from roc.engine.jobserver import Jobserver
 from roc.engine.process import TaskContext
 from roc.engine.ready import Task
 from roc.fsutil import write_text_atomic
-from roc.workspace.dependencies import recursive_dependencies
 from roc.workspace.load import Workspace
 from roc.workspace.package import Package
 
@@ -26,14 +25,11 @@ def plan_build(
 ) -> list[Task]:
     """One ``build`` task per selected package. Whether a package is up to date is checked when its
     task is dispatched (its dependencies built by then)."""
-    by_name = workspace.by_name
-    order = [p.name for p in workspace.ordered]
     selected = workspace.selected
     fingerprints = Fingerprints(workspace, options)
     tasks = []
     for package in workspace.selected_in_order():
-        recursive = recursive_dependencies(package, by_name)
-        dependencies = [n for n in order if n in recursive]
+        dependencies = workspace.dependencies.in_order(package.name)
         build = _PackageBuild(package, workspace.root, dependencies, options, jobserver, fingerprints)
         tasks.append(Task(
             name=package.name,

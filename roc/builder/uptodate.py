@@ -24,7 +24,6 @@ from roc.builder.fingerprint import (
 from roc.builder.layout import package_prefix
 from roc.builder.state import install_intact, read_state
 from roc.buildtypes.context import BuildOptions
-from roc.workspace.dependencies import recursive_dependencies
 from roc.workspace.load import Workspace
 from roc.workspace.package import Package
 
@@ -84,7 +83,7 @@ class Fingerprints:
             "sources": source_parts(files),
             "options": _options_parts(package, self.options),
             "toolchain": toolchain_parts(self.environment, self.options.install_base, tools),
-            "dependencies": {n: self._fingerprint(n) for n in sorted(recursive_dependencies(package, by_name))},
+            "dependencies": {n: self._fingerprint(n) for n in sorted(self.workspace.dependencies.recursive(package.name))},
             "underlay": {n: self._underlay(n) for n in sorted(package.direct_dependencies() - by_name.keys())},
         }
         fingerprint = combine(parts)

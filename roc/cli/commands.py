@@ -12,6 +12,7 @@ import importlib
 
 from roc import __version__
 from roc.errors import EXIT_USAGE
+from roc.messages import did_you_mean
 
 # (command path, aliases, module in roc.commands, help)
 COMMANDS = (
@@ -106,8 +107,6 @@ class Parser(argparse.ArgumentParser):
 def _unrecognized(parser: argparse.ArgumentParser, extras: list[str]) -> str:
     """The message for arguments ``parser`` does not know: colcon options roc lacks by name, and the
     closest option for a misspelled one."""
-    import difflib
-
     for word in extras:
         option = word.split("=", 1)[0]
         if option in COLCON_ONLY_OPTIONS:
@@ -115,9 +114,9 @@ def _unrecognized(parser: argparse.ArgumentParser, extras: list[str]) -> str:
     message = f"unrecognized arguments: {' '.join(extras)}"
     known = [o for a in parser._actions for o in a.option_strings]
     for word in extras:
-        close = difflib.get_close_matches(word.split("=", 1)[0], known, n=1) if word.startswith("--") else []
-        if close:
-            return f"{message}; did you mean {close[0]}?"
+        hint = did_you_mean(word.split("=", 1)[0], known, count=1, quote=False) if word.startswith("--") else ""
+        if hint:
+            return f"{message}; {hint}"
     return message
 
 

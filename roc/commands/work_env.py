@@ -62,14 +62,13 @@ def _current_build_environment(args: argparse.Namespace, root) -> dict[str, str]
     """The environment PKG's build runs in now: the current one plus its installed dependencies' hooks."""
     from roc.builder.environment import build_environment
     from roc.buildtypes.context import BuildOptions
-    from roc.workspace.dependencies import recursive_dependencies
+    from roc.messages import unknown_package
     from roc.workspace.load import load_workspace
 
     workspace = load_workspace(args)
     package = workspace.by_name.get(args.package)
     if package is None:
-        raise UsageError(f"no package named '{args.package}' in the workspace; see 'roc work list -n'")
+        raise UsageError(unknown_package(args.package, workspace.by_name))
     options = BuildOptions(build_base=root / args.build_base, install_base=root / args.install_base,
                            merge_install=args.merge_install)
-    recursive = recursive_dependencies(package, workspace.by_name)
-    return build_environment(package, [p.name for p in workspace.ordered if p.name in recursive], options)
+    return build_environment(package, workspace.dependencies.in_order(package.name), options)

@@ -8,7 +8,6 @@ from pathlib import Path
 
 from roc.cli.options import add_format_argument, add_selection_arguments
 from roc.render import print_json, print_lines
-from roc.workspace.dependencies import recursive_dependencies
 from roc.workspace.load import Workspace
 from roc.workspace.package import CATEGORIES, Package
 
@@ -48,8 +47,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _recursive(workspace: Workspace) -> dict[str, dict[str, int]]:
-    by_name = workspace.by_name
-    return {p.name: recursive_dependencies(p, by_name) for p in workspace.ordered}
+    return {p.name: workspace.dependencies.recursive(p.name) for p in workspace.ordered}
 
 
 def matrix_lines(workspace: Workspace, density: bool, legend: bool) -> list[str]:

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import difflib
 
 from roc.cli.options import add_format_argument, add_selection_arguments
 from roc.errors import RocError, UsageError
+from roc.messages import unknown_package
 from roc.render import print_json, print_lines
 from roc.workspace.package import Package
 
@@ -26,9 +26,7 @@ def run(args: argparse.Namespace) -> int:
     by_name = workspace.by_name
     unknown = [n for n in args.package_names if n not in by_name]
     if unknown:
-        hints = {h for n in unknown for h in difflib.get_close_matches(n, by_name, n=2)}
-        hint = f"; did you mean {', '.join(sorted(hints))}?" if hints else "; run 'roc work list -n' to see them"
-        raise UsageError(f"no package named {', '.join(repr(n) for n in unknown)} in the workspace{hint}")
+        raise UsageError(unknown_package(unknown[0], by_name))
     packages = sorted(
         (p for p in workspace.selected_in_order() if not args.package_names or p.name in args.package_names),
         key=lambda p: p.name,

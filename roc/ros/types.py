@@ -8,7 +8,6 @@ names, and points at an unsourced ``install/`` of the current workspace that hol
 
 from __future__ import annotations
 
-import difflib
 import importlib
 import os
 from functools import lru_cache
@@ -16,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from roc.errors import UsageError
+from roc.messages import did_you_mean
 
 KINDS = ("msg", "srv", "action")
 KIND_NOUNS = {"msg": "message", "srv": "service", "action": "action"}
@@ -133,8 +133,8 @@ def _package_types(package: str, kind: str) -> list[str]:
 
 
 def _did_you_mean(word: str, choices: list[str] | set[str]) -> str:
-    close = difflib.get_close_matches(word, sorted(choices), n=3)
-    return f" (did you mean {' or '.join(repr(c) for c in close)}?)" if close else ""
+    hint = did_you_mean(word, choices)
+    return f" ({hint})" if hint else ""
 
 
 def _unknown_message(name: str, package: str, kinds: list[str], short: str) -> str:

@@ -86,3 +86,24 @@ def recursive_dependencies(
             following |= dependency.direct_dependencies(recursive_categories)
         level = following - depths.keys()
     return depths
+
+
+class DependencyIndex:
+    """The recursive dependencies of a workspace's packages, each computed once per run (selection,
+    planning and fingerprints all ask)."""
+
+    def __init__(self, ordered: list[Package]):
+        self.ordered = ordered
+        self.by_name = {p.name: p for p in ordered}
+        self._recursive: dict[str, dict[str, int]] = {}
+
+    def recursive(self, name: str) -> dict[str, int]:
+        """Workspace packages ``name`` depends on, with their depth (see ``recursive_dependencies``)."""
+        if name not in self._recursive:
+            self._recursive[name] = recursive_dependencies(self.by_name[name], self.by_name)
+        return self._recursive[name]
+
+    def in_order(self, name: str) -> list[str]:
+        """The same names, in topological order (the order their install hooks are applied)."""
+        recursive = self.recursive(name)
+        return [p.name for p in self.ordered if p.name in recursive]

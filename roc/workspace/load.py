@@ -9,7 +9,7 @@ from pathlib import Path
 
 from roc.workspace.cache import cached_discovery
 from roc.workspace.conditions import condition_environment
-from roc.workspace.dependencies import topological_order
+from roc.workspace.dependencies import DependencyIndex, topological_order
 from roc.workspace.package import Package
 from roc.workspace.root import find_workspace_root
 from roc.workspace.selection import (
@@ -20,14 +20,15 @@ from roc.workspace.selection import (
 
 
 class Workspace:
-    def __init__(self, root: Path, ordered: list[Package], selected: set[str]):
+    def __init__(self, root: Path, ordered: list[Package], selected: set[str], index: DependencyIndex | None = None):
         self.root = root
         self.ordered = ordered  # every package not ignored, in topological order
         self.selected = selected
+        self.dependencies = index or DependencyIndex(ordered)
 
     @property
     def by_name(self) -> dict[str, Package]:
-        return {p.name: p for p in self.ordered}
+        return self.dependencies.by_name
 
     def selected_in_order(self) -> list[Package]:
         return [p for p in self.ordered if p.name in self.selected]
@@ -78,4 +79,5 @@ def load_workspace(args: argparse.Namespace) -> Workspace:
     check_selection_arguments(args, names)
     ordered = topological_order(ignore_packages(args, packages))
     build_base = root / getattr(args, "build_base", "build")
-    return Workspace(root=root, ordered=ordered, selected=select_packages(args, ordered, build_base))
+    index = DependencyIndex(ordered)
+    return Workspace(root, ordered, select_packages(args, ordered, build_base, index), index)

@@ -7,14 +7,13 @@ only marks packages as skipped, so they stay in the graph (ordering, recursive d
 from __future__ import annotations
 
 import argparse
-import difflib
 import re
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
 from roc.errors import UsageError
-from roc.messages import warn
-from roc.workspace.dependencies import recursive_dependencies
+from roc.messages import unknown_package, warn
+from roc.workspace.dependencies import DependencyIndex
 from roc.workspace.package import Package
 
 # Options that take package names, checked against the workspace.
@@ -42,9 +41,7 @@ def check_selection_arguments(args: argparse.Namespace, names: set[str]) -> None
     for option, values in checks:
         for name in values:
             if name not in names:
-                close = difflib.get_close_matches(name, sorted(names), n=3)
-                hint = f"; did you mean {', '.join(close)}?" if close else "; run 'roc work list -n' to see the package names"
-                raise UsageError(f"--{option.replace('_', '-')}: no package named '{name}' in the workspace{hint}")
+                raise UsageError(f"--{option.replace('_', '-')}: {unknown_package(name, names)}")
     for option in REGEX_OPTIONS:
         for pattern in getattr(args, option, None) or []:
             try:
@@ -61,15 +58,12 @@ def ignore_packages(args: argparse.Namespace, packages: list[Package]) -> list[P
     return [p for p in packages if p.name not in ignored and not _matches(patterns, p.name)]
 
 
-def select_packages(args: argparse.Namespace, ordered: list[Package], build_base: Path | None = None) -> set[str]:
+def select_packages(args: argparse.Namespace, ordered: list[Package], build_base: Path | None = None,
+                    index: DependencyIndex | None = None) -> set[str]:
     """Names of the packages to process; ``ordered`` is the full topological order."""
-    by_name = {p.name: p for p in ordered}
-    _recursive: dict[str, dict[str, int]] = {}
-
-    def deps_of(name: str) -> dict[str, int]:
-        if name not in _recursive:
-            _recursive[name] = recursive_dependencies(by_name[name], by_name)
-        return _recursive[name]
+    index = index or DependencyIndex(ordered)
+    by_name = index.by_name
+    deps_of = index.recursive
 
     selected = set(by_name)
 
