@@ -9,6 +9,7 @@ from pathlib import Path
 
 from roc.builder.layout import package_prefix
 from roc.buildtypes.context import BuildOptions
+from roc.environment import path_list
 from roc.environment.dsv import apply_operations, resolve_operations
 from roc.workspace.package import Package
 
@@ -35,8 +36,8 @@ def build_environment(package: Package, dependencies: list[str], options: BuildO
             apply_operations(env, prefix, resolve_operations(prefix, dsv))
     if package.type == "ros.ament_cmake":
         # As colcon-ros does: CMake finds ament packages of every AMENT_PREFIX_PATH entry.
-        cmake_paths = [p for p in env.get("CMAKE_PREFIX_PATH", "").split(os.pathsep) if p]
-        extra = [p for p in env.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p and p not in cmake_paths]
+        cmake_paths = path_list(env.get("CMAKE_PREFIX_PATH"))
+        extra = [p for p in path_list(env.get("AMENT_PREFIX_PATH")) if p not in cmake_paths]
         env["CMAKE_PREFIX_PATH"] = os.pathsep.join(cmake_paths + extra)
     return env
 

@@ -20,6 +20,7 @@ import shutil
 import sys
 from pathlib import Path
 
+from roc.environment import path_list
 from roc.fsutil import file_sha256
 from roc.workspace.package import IGNORE_MARKERS
 
@@ -114,8 +115,8 @@ def underlay_prefixes(env: dict[str, str], install_base: Path) -> list[str]:
     own = str(install_base)
     found: list[str] = []
     for name in ("AMENT_PREFIX_PATH", "CMAKE_PREFIX_PATH"):
-        for prefix in env.get(name, "").split(os.pathsep):
-            if prefix and not prefix.startswith(own) and prefix not in found:
+        for prefix in path_list(env.get(name)):
+            if not prefix.startswith(own) and prefix not in found:
                 found.append(prefix)
     return found
 
@@ -152,7 +153,7 @@ def toolchain_parts(env: dict[str, str], install_base: Path, tools: tuple[str, .
     own = str(install_base)
     parts: dict[str, object] = {f"variable {name}": env.get(name) for name in TOOLCHAIN_VARIABLES}
     for name in PREFIX_VARIABLES:
-        parts[f"prefix path {name}"] = [p for p in env.get(name, "").split(os.pathsep) if p and not p.startswith(own)]
+        parts[f"prefix path {name}"] = [p for p in path_list(env.get(name)) if not p.startswith(own)]
     for tool in tools:
         parts[f"tool {tool}"] = _tool_identity(tool, env.get("PATH"))
     parts["python"] = [os.path.realpath(sys.executable), sys.version]

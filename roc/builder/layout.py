@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from roc.environment import path_list
 from roc.errors import RocError, UsageError
 from roc.fsutil import write_text_atomic
 from roc.workspace.dependencies import layered_order
@@ -70,5 +71,5 @@ def refresh_install_scripts(install_base: Path, merged: bool) -> None:
 
     from roc.shell.scripts import write_install_scripts
 
-    underlays = [p for p in os.environ.get("COLCON_PREFIX_PATH", "").split(os.pathsep) if p]
+    underlays = path_list(os.environ.get("COLCON_PREFIX_PATH"))
     write_install_scripts(install_base, installed_in_order(install_base, merged), merged, underlays)

@@ -9,7 +9,12 @@ from roc.builder.environment import ENVIRONMENT_FILE, build_environment
 from roc.builder.finish import finish_package
 from roc.builder.layout import package_prefix
 from roc.builder.state import write_state
-from roc.builder.uptodate import Fingerprints, PackageState, forced_reasons, stale_reasons
+from roc.builder.uptodate import (
+    Fingerprints,
+    PackageState,
+    forced_reasons,
+    stale_reasons,
+)
 from roc.buildtypes import build_function
 from roc.buildtypes.context import BuildOptions, PackageJob
 from roc.engine.jobserver import Jobserver

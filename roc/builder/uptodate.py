@@ -8,17 +8,16 @@ compute them all at once, in the same order.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 from roc.builder.environment import base_environment
 from roc.builder.fingerprint import (
+    build_tools,
     changes,
     combine,
     external_stamp,
     source_parts,
     source_stamps,
     toolchain_parts,
-    build_tools,
     underlay_prefixes,
 )
 from roc.builder.layout import package_prefix

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 from pathlib import Path
 
 from roc.cli.options import add_layout_arguments, add_selection_arguments
@@ -91,7 +90,7 @@ def skip_configured_packages(args: argparse.Namespace, workspace) -> None:
 def warn_about_overrides(args: argparse.Namespace, workspace, install_base: Path) -> None:
     """colcon-override-check's warning: a selected package shadows one that underlay packages use."""
     from roc.messages import warn
-    from roc.workspace.underlay import override_warning, overridden_packages
+    from roc.workspace.underlay import overridden_packages, override_warning
 
     for name in args.allow_overriding:
         if name not in workspace.by_name:

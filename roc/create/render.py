@@ -11,21 +11,17 @@ from xml.sax.saxutils import escape
 
 from roc.create.licenses import license_text
 from roc.create.spec import PackageSpec
+from roc.templates import template_environment
 
 
 @lru_cache(maxsize=1)
 def _templates():
-    import jinja2
-
-    environment = jinja2.Environment(
-        loader=jinja2.PackageLoader("roc.create", "templates"), keep_trailing_newline=True,
-        undefined=jinja2.StrictUndefined, autoescape=False, trim_blocks=True, lstrip_blocks=True,
-    )
-    environment.filters["xml"] = lambda value: escape(str(value), {'"': "&quot;", "'": "&apos;"})
-    environment.filters["py"] = lambda value: repr(str(value))
-    environment.filters["ref"] = lambda name: "${" + name + "}"  # a CMake variable reference
-    environment.filters["camel"] = lambda value: "".join(part.capitalize() for part in value.split("_"))
-    return environment
+    return template_environment("roc.create", {
+        "xml": lambda value: escape(str(value), {'"': "&quot;", "'": "&apos;"}),
+        "py": lambda value: repr(str(value)),
+        "ref": lambda name: "${" + name + "}",  # a CMake variable reference
+        "camel": lambda value: "".join(part.capitalize() for part in value.split("_")),
+    }, trim_blocks=True, lstrip_blocks=True)
 
 
 def _plan(spec: PackageSpec) -> list[tuple[str, str]]:

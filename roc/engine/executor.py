@@ -26,8 +26,8 @@ from roc.engine.events import (
     Tick,
 )
 from roc.engine.process import TaskCancelled, TaskContext, TaskError
-from roc.messages import warn
 from roc.engine.ready import ReadyQueue, Task
+from roc.messages import warn
 
 Handler = Callable[[Event], None]
 TICK_SECONDS = 0.25

@@ -11,6 +11,8 @@ from collections.abc import MutableMapping
 from dataclasses import dataclass
 from pathlib import Path
 
+from roc.environment import path_list
+
 PREPEND_TYPES = ("prepend-non-duplicate", "prepend-non-duplicate-if-exists")
 APPEND_TYPES = ("append-non-duplicate",)
 SET_TYPES = ("set", "set-if-unset")
@@ -77,7 +79,7 @@ def apply_operations(env: MutableMapping[str, str], prefix: Path, operations: li
                 path = _absolute(prefix, value)
                 if operation.kind == "prepend-non-duplicate-if-exists" and not os.path.exists(path):
                     continue
-                entries = [e for e in env.get(operation.name, "").split(os.pathsep) if e and e != path]
+                entries = [e for e in path_list(env.get(operation.name)) if e != path]
                 entries = [path, *entries] if operation.kind in PREPEND_TYPES else [*entries, path]
                 env[operation.name] = os.pathsep.join(entries)
         elif operation.kind == "set" or (operation.kind == "set-if-unset" and not env.get(operation.name)):

@@ -59,7 +59,12 @@ def output_handlers(args: argparse.Namespace, switches: dict[str, bool], root: P
     """Where a run's events go: logs, stored results, and the console (or JSON events on stdout).
     ``verb`` is also the run's own kind of task (``build``, ``test``)."""
     from roc.handlers.console import ConsoleHandler
-    from roc.handlers.logs import JsonEventsHandler, LogHandler, ResultStore, new_log_directory
+    from roc.handlers.logs import (
+        JsonEventsHandler,
+        LogHandler,
+        ResultStore,
+        new_log_directory,
+    )
 
     handlers: list = []
     log_dir = None

@@ -9,6 +9,7 @@ import re
 import sys
 from pathlib import Path
 
+from roc.environment import path_list
 from roc.errors import RocError
 
 KINDS = ("msg", "srv", "action")
@@ -21,7 +22,7 @@ def prefixes() -> list[Path]:
     """AMENT_PREFIX_PATH; when unset, roc's own prefix if it holds an ament index (ROS from wheels)."""
     value = os.environ.get("AMENT_PREFIX_PATH")
     if value:
-        return [Path(p) for p in value.split(os.pathsep) if p]
+        return [Path(p) for p in path_list(value)]
     prefix = Path(sys.prefix)
     return [prefix] if (prefix / "share" / "ament_index" / "resource_index").is_dir() else []
 

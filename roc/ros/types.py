@@ -14,6 +14,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
+from roc.environment import path_list
 from roc.errors import UsageError
 from roc.messages import did_you_mean
 
@@ -112,7 +113,7 @@ def action_class(name: str) -> type:
 # ---- errors -----------------------------------------------------------------------------------
 
 def _prefixes() -> list[Path]:
-    return [Path(p) for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
+    return [Path(p) for p in path_list(os.environ.get("AMENT_PREFIX_PATH"))]
 
 
 def interface_packages() -> set[str]:

@@ -13,23 +13,19 @@ from pathlib import Path
 
 from roc.environment.dsv import Operation, resolve_operations
 from roc.fsutil import write_text_atomic
+from roc.templates import template_environment
 
 SHELLS = ("sh", "bash", "zsh")
 
 
 @lru_cache(maxsize=1)
 def _templates():
-    import jinja2
-
-    environment = jinja2.Environment(
-        loader=jinja2.PackageLoader("roc.shell", "templates"), keep_trailing_newline=True,
-        undefined=jinja2.StrictUndefined, autoescape=False,
-    )
-    environment.filters["shquote"] = lambda value: shlex.quote(str(value))
-    # for values inside "...": keeps spaces and any characters, expands nothing
-    environment.filters["dquote"] = lambda value: re.sub(r'([\\"$`])', r"\\\1", str(value))
-    environment.filters["psquote"] = _powershell_literal
-    return environment
+    return template_environment("roc.shell", {
+        "shquote": lambda value: shlex.quote(str(value)),
+        # for values inside "...": keeps spaces and any characters, expands nothing
+        "dquote": lambda value: re.sub(r'([\\"$`])', r"\\\1", str(value)),
+        "psquote": _powershell_literal,
+    })
 
 
 def _powershell_literal(value: object) -> str:

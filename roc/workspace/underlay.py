@@ -9,6 +9,8 @@ import os
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 
+from roc.environment import path_list
+
 AMENT_INDEX = Path("share", "ament_index", "resource_index", "packages")
 COLCON_INDEX = Path("share", "colcon-core", "packages")
 
@@ -28,10 +30,10 @@ def underlay_packages(environ: Mapping[str, str]) -> dict[str, list[Path]]:
         if prefix not in found.setdefault(name, []):
             found[name].append(prefix)
 
-    for prefix in filter(None, environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep)):
+    for prefix in path_list(environ.get("AMENT_PREFIX_PATH")):
         for name in _names(Path(prefix) / AMENT_INDEX):
             add(name, Path(prefix))
-    for base in filter(None, environ.get("COLCON_PREFIX_PATH", "").split(os.pathsep)):
+    for base in path_list(environ.get("COLCON_PREFIX_PATH")):
         for name in _names(Path(base) / COLCON_INDEX):  # a merged install base
             add(name, Path(base))
         for name in _names(Path(base)):  # an isolated one: BASE/NAME/share/colcon-core/packages/NAME
@@ -44,7 +46,7 @@ def _run_dependencies(name: str, prefix: Path) -> set[str]:
     """What an installed package needs at run time: colcon's package index entry, else its package.xml."""
     index = prefix / COLCON_INDEX / name
     if index.is_file():
-        return set(filter(None, index.read_text().strip().split(os.pathsep)))
+        return set(path_list(index.read_text().strip()))
     manifest = prefix / "share" / name / "package.xml"
     if not manifest.is_file():
         return set()
