@@ -43,10 +43,16 @@ def daemon_key(env: dict[str, str] | None = None) -> str:
     return f"{zlib.crc32(text):08x}{zlib.adler32(text):08x}"
 
 
+# A Unix socket's path must fit in 107 bytes; the longest one roc binds is the daemon's staging name.
+SOCKET_PATH_MAX = 107
+LONGEST_SOCKET_NAME = len(".daemon-0123456789abcdef.sock.4194304")
+
+
 def runtime_dir() -> Path:
-    """A directory only this user can enter: $XDG_RUNTIME_DIR/roc or /tmp/roc-UID."""
+    """A directory only this user can enter: $XDG_RUNTIME_DIR/roc, or /tmp/roc-UID when there is no
+    such directory or its path is too long for a socket."""
     base = os.environ.get("XDG_RUNTIME_DIR")
-    if base and Path(base).is_dir():
+    if base and Path(base).is_dir() and len(os.path.join(base, "roc")) + 1 + LONGEST_SOCKET_NAME <= SOCKET_PATH_MAX:
         path = Path(base) / "roc"
     else:
         import tempfile
