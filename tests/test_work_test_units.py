@@ -7,7 +7,8 @@ import argparse
 from pathlib import Path
 
 from roc.cli.options import add_selection_arguments
-from roc.testing.cache import passed_before, read_test_state, results_key, write_test_state
+from roc.testing.cache import read_test_state, rerun_reasons, results_key, results_parts, write_test_state
+from roc.testing.plan import PackageTest
 from roc.testing.runner import TestOptions, pytest_addopts
 from roc.workspace.package import Package
 from roc.workspace.selection import select_packages
@@ -35,22 +36,60 @@ def test_cached_result_needs_the_same_key_a_pass_and_the_result_files(tmp_path: 
     (source / "test_it.py").write_text("def test_ok(): pass\n")
     (build / "pkg").mkdir(parents=True)
     assert results_key(source, build, "pkg", [], {}, {})[0] is None  # not built by roc: never cached
+    assert rerun_reasons({}, results_parts(source, build, "pkg", [], {}, {})[0]) == ["not built by roc"]
     (build / "pkg" / "roc_state.json").write_text('{"fingerprint": "f1", "files": {}}')
-    key, files = results_key(source, build, "pkg", [], {}, {})
+    (build / "dep").mkdir()
+    (build / "dep" / "roc_state.json").write_text('{"fingerprint": "d1", "files": {}}')
+
+    def reasons(options: dict | None = None) -> list[str]:
+        state = read_test_state(build / "pkg")
+        return rerun_reasons(state, results_parts(source, build, "pkg", ["dep"], options or {}, state)[0])
+
+    assert reasons() == ["never tested"]
+    parts, files = results_parts(source, build, "pkg", ["dep"], {}, {})
+    key, _ = results_key(source, build, "pkg", ["dep"], {}, {})
+    write_test_state(build / "pkg", key, False, files, [], parts)
+    assert reasons() == ["failed last time"]
     result = build / "pkg" / "pytest.xml"
     result.write_text("<testsuite tests='1' failures='0'/>")
-    write_test_state(build / "pkg", key, True, files, [str(result)])
-    state = read_test_state(build / "pkg")
-    assert passed_before(state, key)
-    assert not passed_before(state, results_key(source, build, "pkg", [], {"pytest": ["-x"]}, state)[0])
+    write_test_state(build / "pkg", key, True, files, [str(result)], parts)
+    assert reasons() == []
+    assert reasons({"pytest": ["-x"]}) == ["option changed: pytest"]
     (source / "test_it.py").write_text("def test_ok(): assert True\n")
-    assert not passed_before(state, results_key(source, build, "pkg", [], {}, state)[0])
+    (source / "test_new.py").write_text("")
+    assert reasons() == ["files added: test_new.py", "files changed: test_it.py"]
+    (source / "test_new.py").unlink()
     (source / "test_it.py").write_text("def test_ok(): pass\n")
-    assert passed_before(state, results_key(source, build, "pkg", [], {}, state)[0])
+    assert reasons() == []
+    (build / "pkg" / "roc_state.json").write_text('{"fingerprint": "f2", "files": {}}')
+    assert reasons() == ["build changed"]
+    (build / "pkg" / "roc_state.json").write_text('{"fingerprint": "f1", "files": {}}')
+    (build / "dep" / "roc_state.json").write_text('{"fingerprint": "d2", "files": {}}')
+    assert reasons() == ["dependency changed: dep"]
+    (build / "dep" / "roc_state.json").write_text('{"fingerprint": "d1", "files": {}}')
     result.unlink()
-    assert not passed_before(state, key)
-    write_test_state(build / "pkg", key, False, files, [])
-    assert not passed_before(read_test_state(build / "pkg"), key)
+    assert reasons() == ["result files missing"]
+
+
+def test_the_check_runs_at_dispatch_and_says_why(tmp_path: Path) -> None:
+    """A test task's check reads the state when it is called (not when the task is planned)."""
+    source, build = tmp_path / "src" / "pkg", tmp_path / "build"
+    source.mkdir(parents=True)
+    (source / "test_it.py").write_text("def test_ok(): pass\n")
+    (build / "pkg").mkdir(parents=True)
+    package = Package(name="pkg", path=Path("src", "pkg"), type="ros.ament_python", dependencies={})
+    options = TestOptions(build_base=build, install_base=tmp_path / "install")
+    test = PackageTest(package, source, [], options)
+    assert test.check() == ["not built by roc"]
+    (build / "pkg" / "roc_state.json").write_text('{"fingerprint": "f1", "files": {}}')  # built since
+    assert test.check() == ["never tested"]
+    write_test_state(build / "pkg", "some key", True, test.files, [], test.parts)
+    assert test.check() == ["test inputs changed"]
+    write_test_state(build / "pkg", results_key(source, build, "pkg", [], options.digest(), {})[0], True,
+                     test.files, [], test.parts)
+    assert test.check() == []
+    assert PackageTest(package, source, [], options, force=True).check() == ["--force"]
+    assert PackageTest(package, source, [], options, use_cache=False).check() == ["--no-cache"]
 
 
 def test_selection_by_the_last_test_result(tmp_path: Path) -> None:
