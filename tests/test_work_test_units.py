@@ -4,10 +4,30 @@ the last test result."""
 from __future__ import annotations
 
 import argparse
+import io
 from pathlib import Path
 
 from roc.cli.options import add_selection_arguments
-from roc.testing.cache import read_test_state, rerun_reasons, results_key, results_parts, write_test_state
+from roc.engine.events import (
+    RunFinished,
+    TaskAborted,
+    TaskFailed,
+    TaskFinished,
+    TaskOutput,
+    TaskQueued,
+    TaskSkipped,
+    TaskStarted,
+    TestFailures,
+)
+from roc.handlers.console import ConsoleHandler
+from roc.handlers.logs import ResultStore
+from roc.testing.cache import (
+    read_test_state,
+    rerun_reasons,
+    results_key,
+    results_parts,
+    write_test_state,
+)
 from roc.testing.plan import PackageTest
 from roc.testing.runner import TestOptions, pytest_addopts
 from roc.workspace.package import Package
@@ -104,3 +124,69 @@ def test_selection_by_the_last_test_result(tmp_path: Path) -> None:
     assert select_packages(failures, packages, tmp_path) == {"failed"}
     not_passed = parser.parse_args(["--packages-skip-test-passed"])
     assert select_packages(not_passed, packages, tmp_path) == {"failed", "aborted", "untested"}
+
+
+def test_console_names_the_runs_own_kind_as_colcon_and_other_kinds_by_key() -> None:
+    """``roc work test`` prints ``Starting >>> pkg`` for its test tasks (as colcon test does); a task of
+    another kind in the same run is named by its key."""
+    stream = io.StringIO()
+    console = ConsoleHandler(stream, kind="test", cached_label="cached",
+                             finished_note=lambda key: "\t[ with test failures ]" if key == "test:b" else "")
+    for event in (TaskQueued("a", "test"), TaskQueued("b", "test"), TaskQueued("c", "test"), TaskQueued("d", "test"),
+                  TaskQueued("x"), TaskStarted("x"), TaskFinished("x", duration=1.0),
+                  TaskFinished("a", "test", cached=True),
+                  TaskStarted("b", "test"), TaskOutput("b", "test", stream="stderr", data=b"oops\n"),
+                  TestFailures("b", "test"),
+                  TaskFinished("b", "test", duration=1.0), TaskStarted("c", "test"),
+                  TaskFailed("c", "test", duration=1.0, reason="ctest exited with code 2"),
+                  TaskSkipped("d", "test", because_of="test:c"), RunFinished("")):
+        console(event)
+    lines = stream.getvalue().splitlines()
+    assert lines[:9] == ["Starting >>> x", "Finished <<< x [1.00s]",
+                         "Starting >>> b", "--- stderr: b", "oops", "---",
+                         "Finished <<< b [1.00s]\t[ with test failures ]", "Starting >>> c",
+                         "Failed   <<< c [1.00s, ctest exited with code 2]"]
+    assert lines[11:] == ["  1 package cached: a", "  1 package failed: c",
+                          "  1 package skipped because a dependency failed: d (needs c)",
+                          "  1 package had stderr output: b", "  1 package had test failures: b"]
+
+    build = io.StringIO()
+    console = ConsoleHandler(build, kind="build")
+    for event in (TaskQueued("a", "idl"), TaskStarted("a", "idl"), TaskFinished("a", "idl", duration=1.0),
+                  TaskStarted("a"), TaskFinished("a", duration=1.0)):
+        console(event)
+    assert build.getvalue().splitlines() == ["Starting >>> idl:a", "Finished <<< idl:a [1.00s]",
+                                             "Starting >>> a", "Finished <<< a [1.00s]"]
+
+
+def test_status_line_names_the_runs_own_kind_by_package() -> None:
+    from rich.console import Console
+
+    from roc.handlers.status import StatusLine
+
+    class Live:
+        def __init__(self) -> None:
+            self.updates: list[str] = []
+
+        def start(self) -> None: ...
+
+        def update(self, renderable, refresh: bool = False) -> None:
+            self.updates.append(str(renderable))
+
+    live = Live()
+    status = StatusLine(console=Console(file=io.StringIO(), width=120), live=live, clock=lambda: 0.0, kind="test")
+    status.MIN_INTERVAL = -1.0
+    for event in (TaskQueued("a", "test"), TaskQueued("a", "idl"), TaskStarted("a", "test"), TaskStarted("a", "idl")):
+        status(event)
+    assert live.updates[-1] == "[0s] [0/2 done] [2 running] a idl:a"
+
+
+def test_result_store_writes_colcons_test_results(tmp_path: Path) -> None:
+    store = ResultStore(tmp_path)
+    for event in (TaskFinished("passed", "test"), TestFailures("failing", "test"), TaskFinished("failing", "test"),
+                  TaskFailed("error", "test"), TaskAborted("stopped", "test"), TaskFinished("built"),
+                  TaskFinished("generated", "idl")):
+        store(event)
+    assert {p.relative_to(tmp_path).as_posix(): p.read_text() for p in tmp_path.glob("*/*")} == {
+        "passed/colcon_test.rc": "0\n", "failing/colcon_test.rc": "test failures\n",
+        "error/colcon_test.rc": "1\n", "stopped/colcon_test.rc": "SIGINT\n", "built/colcon_build.rc": "0\n"}
