@@ -22,7 +22,6 @@ from roc.testing.cache import (
 )
 from roc.testing.results import collect_results
 from roc.testing.runner import TestOptions, run_package_tests
-from roc.workspace.dependencies import recursive_dependencies
 from roc.workspace.load import Workspace
 from roc.workspace.package import Package
 
@@ -33,12 +32,9 @@ def plan_tests(workspace: Workspace, options: TestOptions, weights: dict[str, fl
                use_cache: bool = True) -> list[Task]:
     """One task per selected package, after the selected packages it depends on (as colcon orders
     tests)."""
-    by_name = workspace.by_name
-    order = [p.name for p in workspace.ordered]
     tasks = []
     for package in workspace.selected_in_order():
-        recursive = recursive_dependencies(package, by_name)
-        dependencies = [n for n in order if n in recursive]
+        dependencies = workspace.dependencies.in_order(package.name)
         test = PackageTest(package, (workspace.root / package.path).resolve(), dependencies, options, force,
                            use_cache)
         key = task_key(KIND, package.name)
