@@ -17,6 +17,13 @@ def print_lines(lines: Iterable[str], stream: TextIO | None = None) -> None:
     (stream or sys.stdout).write("".join(f"{line}\n" for line in lines))
 
 
+def print_text(text: str, stream: TextIO | None = None) -> None:
+    """Text as it is, flushed (for streams: each message as it arrives, also through a pipe)."""
+    out = stream or sys.stdout
+    out.write(text)
+    out.flush()
+
+
 def print_json(data: Any, stream: TextIO | None = None) -> None:
     """One JSON document, indented (for listings)."""
     out = stream or sys.stdout

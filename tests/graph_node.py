@@ -2,7 +2,7 @@
 
     python graph_node.py '{"name": "talker", "namespace": "/", "publishers": [{"topic": "chatter",
         "type": "std_msgs/msg/String", "reliability": "best_effort", "durability": "volatile",
-        "depth": 10, "deadline_ms": 0}], "subscribers": [...], "services": [{"name": "reset",
+        "depth": 10, "deadline_ms": 0, "values": {"data": "hi"}, "rate_hz": 10}], "subscribers": [{..., "print": true}], "services": [{"name": "reset",
         "type": "std_srvs/srv/Trigger"}], "actions": [{"name": "fibonacci"}], "parameters": {"max_speed": 1.5}}'
 
 Several nodes in one process: pass a JSON list. Prints "ready" once everything is created, then
@@ -41,9 +41,17 @@ def make_node(spec: dict) -> Node:
     for name, value in spec.get("parameters", {}).items():
         node.declare_parameter(name, value)
     for pub in spec.get("publishers", []):
-        node.create_publisher(load(pub["type"]), pub["topic"], qos(pub))
+        publisher = node.create_publisher(load(pub["type"]), pub["topic"], qos(pub))
+        if "values" in pub:  # {"data": "hello"}: published at once, then at "rate_hz" if given
+            message = load(pub["type"])(**pub["values"])
+            publisher.publish(message)
+            if pub.get("rate_hz"):
+                node.create_timer(1.0 / pub["rate_hz"], lambda p=publisher, m=message: p.publish(m))
     for sub in spec.get("subscribers", []):
-        node.create_subscription(load(sub["type"]), sub["topic"], lambda _msg: None, qos(sub))
+        def received(msg, topic=sub["topic"], show=sub.get("print", False)) -> None:
+            if show:  # one line per message: the topic and the message's repr
+                print(json.dumps({"topic": topic, "message": repr(msg)}), flush=True)
+        node.create_subscription(load(sub["type"]), sub["topic"], received, qos(sub))
     for srv in spec.get("services", []):
         node.create_service(load(srv["type"]), srv["name"], lambda _req, resp: resp)
     for client in spec.get("clients", []):

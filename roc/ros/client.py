@@ -213,3 +213,25 @@ def query(method: str, params: dict[str, Any] | None = None, *, use_daemon: bool
         return connection.request(method, params)
     finally:
         connection.close()
+
+
+def stream(method: str, params: dict[str, Any], *, use_daemon: bool = True,
+           **local: Any) -> Iterator[dict[str, Any]]:
+    """The events of a streaming request (roc.ros.dataplane), in the daemon unless ``use_daemon`` is
+    false (``local``: options of roc.ros.dataplane.local_stream); closing the iterator (or Ctrl+C) ends
+    the stream and removes its endpoint."""
+    if not use_daemon:
+        from roc.ros.dataplane import local_stream
+
+        events = local_stream(method, params, **local)
+        yield from (event for event in events if event.get("event") != "heartbeat")
+        return
+    connection = start_daemon()
+    try:
+        for response in connection.stream(method, params):
+            if "error" in response:
+                raise DaemonError(response["error"]["message"])
+            if response.get("event") not in (None, "heartbeat"):
+                yield response
+    finally:
+        connection.close()

@@ -79,10 +79,10 @@ def full_name(namespace: str, name: str) -> str:
 class Graph:
     """A hidden rclpy node in its own context, spun in a background thread (for service calls)."""
 
-    def __init__(self) -> None:
+    def __init__(self, node_name: str | None = None) -> None:
         self.context = Context()
         rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)
-        self.node = Node(f"_roc_{os.getpid()}", context=self.context, start_parameter_services=False,
+        self.node = Node(node_name or f"_roc_{os.getpid()}", context=self.context, start_parameter_services=False,
                          enable_rosout=False)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)

@@ -1,0 +1,192 @@
+"""Moving data on a live graph: a subscription (``echo``) and a publisher (``publish``) on a Graph's
+node, each a stream of plain-data events. The same generators run inside the roc daemon (each event a
+line on the client's socket, so the endpoint lives in an already discovered participant) and in a
+daemon-less run. Messages travel as serialised CDR (base64 in JSON); the client turns them into
+message objects (``decode``), so the daemon never needs a verb's output options.
+
+A stream ends when its generator is closed: the daemon closes it when the client goes away (a
+heartbeat event at least every HEARTBEAT_SECONDS finds out), and the ``finally`` blocks destroy the
+endpoint, so an interrupted client leaves none behind.
+"""
+
+from __future__ import annotations
+
+import base64
+import contextlib
+import queue
+import time
+from collections.abc import Callable, Iterator
+from typing import Any
+
+from rclpy.qos import (
+    DurabilityPolicy,
+    HistoryPolicy,
+    LivelinessPolicy,
+    QoSPresetProfiles,
+    QoSProfile,
+    ReliabilityPolicy,
+)
+from rclpy.serialization import deserialize_message, serialize_message
+
+from roc.errors import RocError
+from roc.ros.types import message_class
+
+HEARTBEAT_SECONDS = 0.5
+POLL_SECONDS = 0.05
+_POLICIES = {"history": HistoryPolicy, "reliability": ReliabilityPolicy, "durability": DurabilityPolicy,
+             "liveliness": LivelinessPolicy}
+
+
+def qos_profile(options: dict[str, Any], publishers: list | None = None) -> QoSProfile:
+    """The profile ``options`` ask for (``profile``, ``depth``, ``history``, ``reliability``,
+    ``durability``, ``liveliness``, ``liveliness_lease_seconds``). Reliability and durability not given
+    follow ``publishers`` (rclpy endpoint infos) as ros2 does: reliable / transient local only when
+    every publisher is."""
+    profile = QoSPresetProfiles.get_from_short_key(options.get("profile", "default"))
+    profile = QoSProfile(**{slot.lstrip("_"): getattr(profile, slot) for slot in profile.__slots__})
+    for name, policy in _POLICIES.items():
+        if options.get(name):
+            setattr(profile, name, policy.get_from_short_key(options[name]))
+    if options.get("depth") is not None:
+        profile.depth = options["depth"]
+    if options.get("liveliness_lease_seconds") is not None:
+        from rclpy.duration import Duration
+
+        profile.liveliness_lease_duration = Duration(seconds=options["liveliness_lease_seconds"])
+    if publishers:
+        if not options.get("reliability"):
+            reliable = all(p.qos_profile.reliability == ReliabilityPolicy.RELIABLE for p in publishers)
+            profile.reliability = ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT
+        if not options.get("durability"):
+            latched = all(p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for p in publishers)
+            profile.durability = DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE
+    return profile
+
+
+def decode(type_name: str, data: str) -> Any:
+    """A message object from the base64 CDR of an ``echo`` event."""
+    return deserialize_message(base64.b64decode(data), message_class(type_name))
+
+
+def serialize(message: Any) -> bytes:
+    """A message's CDR, as a raw publisher sends it."""
+    return serialize_message(message)
+
+
+def encode(message: Any) -> str:
+    """The base64 CDR of a message, for a ``publish`` request."""
+    return base64.b64encode(serialize(message)).decode()
+
+
+def publishers(graph, topic: str, wait: float) -> list:
+    """The topic's publishers (rclpy endpoint infos), waiting up to ``wait`` seconds for one to appear
+    (a fresh participant discovers them)."""
+    deadline = time.monotonic() + wait
+    while True:
+        found = graph.node.get_publishers_info_by_topic(topic)
+        if found or time.monotonic() >= deadline:
+            return found
+        time.sleep(POLL_SECONDS)
+
+
+def echo(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+    """Subscribe to ``params["topic"]`` and yield ``{"event": "message", "data", "info", "lost"}`` per
+    message (``lost``: messages the publisher's sequence numbers say never arrived), ``{"event":
+    "subscribed", "type"}`` first and heartbeats in between. Params: ``topic``, ``wait`` (seconds to
+    wait for a publisher to be discovered), ``type`` (else the graph's), ``qos`` (see qos_profile), ``timeout`` (seconds for the
+    first message; then ``{"event": "timeout"}`` ends the stream)."""
+    topic = params["topic"]
+    found = publishers(graph, topic, params.get("wait", 0.0))
+    if not found:
+        yield {"event": "not_published"}
+    type_name = params.get("type") or next(
+        (types[0] for name, types in graph.node.get_topic_names_and_types() if name == topic), None)
+    if type_name is None:
+        raise RocError("Could not determine the type for the passed topic")
+    cls = message_class(type_name)
+    profile = qos_profile(params.get("qos", {}), found)
+    arrived: queue.SimpleQueue = queue.SimpleQueue()
+    subscription = graph.node.create_subscription(
+        cls, topic, lambda data, info: arrived.put((data, info)), profile, raw=True)
+    try:
+        yield {"event": "subscribed", "type": type_name}
+        last_sequence: int | None = None
+        timeout = params.get("timeout")
+        deadline = time.monotonic() + timeout if timeout is not None else None
+        while True:
+            try:
+                data, info = arrived.get(timeout=HEARTBEAT_SECONDS)
+            except queue.Empty:
+                if deadline is not None and time.monotonic() >= deadline:
+                    yield {"event": "timeout"}
+                    return
+                yield {"event": "heartbeat"}
+                continue
+            deadline = None  # a message arrived: the timeout is over
+            sequence = info.get("publication_sequence_number")
+            lost = 0
+            if sequence is not None and last_sequence is not None and sequence > last_sequence + 1:
+                lost = sequence - last_sequence - 1  # a lower number: another publisher, nothing lost
+            last_sequence = sequence
+            yield {"event": "message", "data": base64.b64encode(data).decode(), "lost": lost,
+                   "info": {key: value for key, value in info.items() if value is not None}}
+    finally:
+        graph.node.destroy_subscription(subscription)
+
+
+def publish(graph, params: dict[str, Any], prepare: Callable[[], bytes] | None = None) -> Iterator[dict[str, Any]]:
+    """Publish ``params["data"]`` (base64 CDR of a ``type`` message) on ``topic``: wait for ``wait``
+    matching subscriptions (``{"event": "waiting"}`` each second, at most ``max_wait`` seconds), then
+    ``times`` messages (0: until closed) at ``rate`` Hz, ``{"event": "published", "count"}`` after each,
+    keeping the publisher ``keep_alive`` seconds after the last. In-process only: ``prepare`` gives the
+    CDR to send before each message (stamped with the time)."""
+    cls = message_class(params["type"])
+    data = base64.b64decode(params["data"])
+    profile = qos_profile({"profile": "default", **params.get("qos", {})})
+    publisher = graph.node.create_publisher(cls, params["topic"], profile)
+    try:
+        wanted, max_wait = params.get("wait", 0), params.get("max_wait")
+        started = next_notice = time.monotonic()
+        while publisher.get_subscription_count() < wanted:
+            now = time.monotonic()
+            if max_wait is not None and now - started >= max_wait:
+                raise RocError(f"Timed out waiting for subscribers: Expected {wanted} subscribers but only got "
+                               f"{publisher.get_subscription_count()} subscribers")
+            if now >= next_notice:
+                yield {"event": "waiting", "subscriptions": wanted}
+                next_notice += 1.0
+            time.sleep(POLL_SECONDS)
+        yield {"event": "started"}
+        times, period = params.get("times", 0), 1.0 / params["rate"] if params.get("rate") else 1.0
+        count, due = 0, time.monotonic()
+        while not times or count < times:
+            publisher.publish(prepare() if prepare is not None else data)
+            count += 1
+            yield {"event": "published", "count": count}
+            if times and count == times:
+                break
+            due += period
+            while (remaining := due - time.monotonic()) > 0:
+                time.sleep(min(remaining, HEARTBEAT_SECONDS))
+                if remaining > HEARTBEAT_SECONDS:
+                    yield {"event": "heartbeat"}
+        time.sleep(params.get("keep_alive", 0.1))
+    finally:
+        graph.node.destroy_publisher(publisher)
+
+
+STREAMS = {"echo": echo, "publish": publish}
+
+
+def local_stream(method: str, params: dict[str, Any], node_name: str | None = None,
+                 **in_process: Any) -> Iterator[dict[str, Any]]:
+    """A stream without the daemon: its endpoint on a fresh participant of this process, on a node
+    named ``node_name`` (default: a hidden one)."""
+    from roc.ros.graph import Graph
+
+    graph = Graph(node_name)
+    try:
+        with contextlib.closing(STREAMS[method](graph, params, **in_process)) as events:
+            yield from events
+    finally:
+        graph.close()

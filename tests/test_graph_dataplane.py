@@ -1,0 +1,128 @@
+"""roc topic echo / topic pub on a live graph: real rclpy nodes in subprocesses, through the roc daemon
+and without it."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import time
+
+import pytest
+from build_helpers import BIN, stop_process
+from graph_helpers import graph_env, roc, start_nodes, stop_all, stop_daemon
+
+pytestmark = pytest.mark.slow
+
+TALKER = {"name": "talker", "publishers": [
+    {"topic": "chatter", "type": "std_msgs/msg/String", "values": {"data": "hello"}, "rate_hz": 20},
+    {"topic": "latched", "type": "std_msgs/msg/String", "values": {"data": "kept"},
+     "durability": "transient_local", "depth": 1}]}
+LISTENER = {"name": "listener", "subscribers": [
+    {"topic": "cmd", "type": "geometry_msgs/msg/Twist", "print": True}]}
+
+
+@pytest.fixture(scope="module")
+def graph(tmp_path_factory):
+    env = graph_env(80, tmp_path_factory.mktemp("runtime"))
+    processes = start_nodes([[TALKER], [LISTENER]], env)
+    yield env, processes[1]
+    stop_daemon(env)
+    stop_all(processes)
+
+
+@pytest.mark.parametrize("daemon", [True, False], ids=["daemon", "no-daemon"])
+def test_echo_once_prints_a_message_as_ros2_does(graph, daemon: bool) -> None:
+    env, _ = graph
+    flags = [] if daemon else ["--no-daemon"]
+    result = roc("topic", "echo", "/chatter", "--once", *flags, env=env)
+    assert (result.returncode, result.stdout, result.stderr) == (0, "data: hello\n---\n", "")
+    field = roc("topic", "echo", "/chatter", "std_msgs/msg/String", "--once", "--field", "data", *flags, env=env)
+    assert (field.returncode, field.stdout) == (0, "hello\n---\n")
+
+
+def test_echo_adapts_to_a_transient_local_publisher_and_prints_json(graph) -> None:
+    env, _ = graph
+    result = roc("topic", "echo", "/latched", "--once", "--format", "json", "-i", env=env)
+    assert result.returncode == 0, result.stderr
+    line = json.loads(result.stdout)
+    assert (line["topic"], line["type"], line["message"], line["lost"]) == ("/latched", "std_msgs/msg/String",
+                                                                            {"data": "kept"}, 0)
+    assert line["info"]["publication_sequence_number"] == 1
+    filtered = roc("topic", "echo", "/chatter", "--once", "--filter", "m.data == 'hello'", "--csv", env=env)
+    assert (filtered.returncode, filtered.stdout) == (0, "hello\n")
+
+
+def test_echo_errors_are_one_line(graph) -> None:
+    env, _ = graph
+    missing = roc("topic", "echo", "/nobody", "--once", env=env)
+    assert missing.returncode == 1
+    assert missing.stdout == "WARNING: topic [/nobody] does not appear to be published yet\n"
+    assert missing.stderr == "roc: error: Could not determine the type for the passed topic\n"
+    quiet = roc("topic", "echo", "/nobody", "std_msgs/msg/String", "--timeout", "1", env=env)
+    assert quiet.returncode == 1
+    assert quiet.stderr == "roc: error: no message on /nobody within 1 s (--timeout)\n"
+    unknown = roc("topic", "echo", "/chatter", "nope_msgs/msg/Nope", env=env)
+    assert unknown.returncode == 2 and "unknown message type 'nope_msgs/msg/Nope'" in unknown.stderr
+
+
+def _received(listener: subprocess.Popen, count: int, timeout: float = 10.0) -> list[str]:
+    """The next ``count`` messages the listener printed."""
+    lines, deadline = [], time.monotonic() + timeout
+    while len(lines) < count and time.monotonic() < deadline:
+        line = listener.stdout.readline()
+        if line:
+            lines.append(json.loads(line)["message"])
+    return lines
+
+
+@pytest.mark.parametrize("daemon", [True, False], ids=["daemon", "no-daemon"])
+def test_pub_reaches_a_real_subscriber(graph, daemon: bool) -> None:
+    env, listener = graph
+    flags = [] if daemon else ["--no-daemon"]
+    result = roc("topic", "pub", "-t", "3", "-r", "20", "/cmd", "geometry_msgs/msg/Twist",
+                 "{linear: {x: 0.5}, angular: {z: -1}}", *flags, env=env)
+    assert result.returncode == 0, result.stderr
+    twist = ("geometry_msgs.msg.Twist(linear=geometry_msgs.msg.Vector3(x=0.5, y=0.0, z=0.0), "
+             "angular=geometry_msgs.msg.Vector3(x=0.0, y=0.0, z=-1.0))")
+    assert result.stdout.endswith("publisher: beginning loop\n" + "".join(
+        f"publishing #{n}: {twist}\n\n" for n in (1, 2, 3)))
+    assert _received(listener, 3) == [twist] * 3
+
+
+def test_pub_checks_values_before_waiting(graph) -> None:
+    env, _ = graph
+    started = time.monotonic()
+    result = roc("topic", "pub", "--once", "/nobody", "geometry_msgs/msg/Twist", "{linear: {q: 1.0}}", env=env)
+    assert (result.returncode, result.stdout) == (2, "")
+    assert result.stderr.startswith("roc: error: linear.q: geometry_msgs/msg/Vector3 has no field 'q' (x, y, z)")
+    assert time.monotonic() - started < 10  # not after a wait for subscribers (there are none)
+    timed_out = roc("topic", "pub", "--once", "--max-wait-time-secs", "1", "/nobody", "std_msgs/msg/String",
+                    "{data: hi}", env=env)
+    assert timed_out.returncode == 1
+    assert timed_out.stdout == "Waiting for at least 1 matching subscription(s)...\n"
+    assert timed_out.stderr == ("roc: error: Timed out waiting for subscribers: Expected 1 subscribers but only "
+                                "got 0 subscribers\n")
+
+
+def test_ctrl_c_leaves_no_subscription_in_the_daemon(graph) -> None:
+    env, _ = graph
+
+    def subscribers() -> int:
+        info = roc("topic", "info", "/chatter", "--format", "json", env=env)
+        return len(json.loads(info.stdout)["subscribers"])
+
+    before = subscribers()
+    echo = subprocess.Popen([str(BIN / "roc"), "topic", "echo", "/chatter"], env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        assert echo.stdout.readline() == "data: hello\n"
+        assert subscribers() == before + 1  # the echo's subscription lives in the daemon
+        echo.send_signal(signal.SIGINT)
+        assert echo.wait(timeout=10) == 130
+    finally:
+        stop_process(echo)
+    deadline = time.monotonic() + 10
+    while subscribers() != before and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert subscribers() == before
