@@ -46,7 +46,11 @@ def make_node(spec: dict) -> Node:
             message = load(pub["type"])(**pub["values"])
             publisher.publish(message)
             if pub.get("rate_hz"):
-                node.create_timer(1.0 / pub["rate_hz"], lambda p=publisher, m=message: p.publish(m))
+                def tick(p=publisher, m=message, n=node, stamp=pub.get("stamp_now", False)) -> None:
+                    if stamp:  # a std_msgs/Header: stamped with the time of publication
+                        m.stamp = n.get_clock().now().to_msg()
+                    p.publish(m)
+                node.create_timer(1.0 / pub["rate_hz"], tick)
     for sub in spec.get("subscribers", []):
         def received(msg, topic=sub["topic"], show=sub.get("print", False)) -> None:
             if show:  # one line per message: the topic and the message's repr

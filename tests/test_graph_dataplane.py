@@ -17,7 +17,9 @@ pytestmark = pytest.mark.slow
 TALKER = {"name": "talker", "publishers": [
     {"topic": "chatter", "type": "std_msgs/msg/String", "values": {"data": "hello"}, "rate_hz": 20},
     {"topic": "latched", "type": "std_msgs/msg/String", "values": {"data": "kept"},
-     "durability": "transient_local", "depth": 1}]}
+     "durability": "transient_local", "depth": 1},
+    {"topic": "stamped", "type": "std_msgs/msg/Header", "values": {"frame_id": "map"}, "rate_hz": 50,
+     "stamp_now": True}]}
 LISTENER = {"name": "listener", "subscribers": [
     {"topic": "cmd", "type": "geometry_msgs/msg/Twist", "print": True}]}
 
@@ -126,3 +128,45 @@ def test_ctrl_c_leaves_no_subscription_in_the_daemon(graph) -> None:
     while subscribers() != before and time.monotonic() < deadline:
         time.sleep(0.2)
     assert subscribers() == before
+
+
+def _run_for(seconds: float, *args: str, env: dict[str, str]) -> tuple[int, str, str]:
+    """A streaming roc command interrupted (SIGINT, as Ctrl+C) after ``seconds``."""
+    process = subprocess.Popen([str(BIN / "roc"), *args], env=env, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    try:
+        time.sleep(seconds)
+        process.send_signal(signal.SIGINT)
+        out, err = process.communicate(timeout=10)
+    finally:
+        stop_process(process)
+    return process.returncode, out, err
+
+
+def test_hz_bw_and_delay_measure_live_topics(graph) -> None:
+    from rclpy.serialization import serialize_message
+    from std_msgs.msg import String
+
+    env, _ = graph
+    code, out, err = _run_for(3.5, "topic", "hz", "/chatter", "/stamped", "--format", "json", env=env)
+    assert code == 130, err
+    last = {line["topic"]: line for line in map(json.loads, out.splitlines())}
+    assert last["/chatter"]["rate"] == pytest.approx(20, rel=0.02)
+    assert last["/stamped"]["rate"] == pytest.approx(50, rel=0.02)
+    assert last["/chatter"]["lost"] == 0
+    code, out, _ = _run_for(2.5, "topic", "hz", "/chatter", env=env)
+    lines = out.splitlines()
+    assert lines[0].startswith("average rate: ") and float(lines[0].split(": ")[1]) == pytest.approx(20, rel=0.02)
+    assert lines[1].startswith("\tmin: ") and " window: " in lines[1]
+
+    code, out, _ = _run_for(2.5, "topic", "bw", "/chatter", env=env)
+    size = -(-len(serialize_message(String(data="hello"))) // 4) * 4  # as received: padded to 4 bytes
+    assert out.splitlines()[0] == "Subscribed to [/chatter]"
+    assert out.splitlines()[2] == f"\tMessage size mean: {size} B min: {size} B max: {size} B"
+    code, out, _ = _run_for(2.5, "topic", "bw", "/chatter", "--format", "json", env=env)
+    bandwidth = json.loads(out.splitlines()[-1])
+    assert bandwidth["bytes_per_second"] == pytest.approx(size * 20, rel=0.1)
+
+    code, out, _ = _run_for(2.5, "topic", "delay", "/stamped", "--format", "json", env=env)
+    delay = json.loads(out.splitlines()[-1])
+    assert 0 <= delay["min"] <= delay["delay"] <= delay["max"] < 0.5

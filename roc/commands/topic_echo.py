@@ -41,7 +41,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_graph_arguments(parser)
 
 
-def _filter(expression: str | None):
+def message_filter(expression: str | None):
+    """A function of a message for ``--filter EXPR`` (None without it); a bad expression is a usage error."""
     if expression is None:
         return None
     try:
@@ -62,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("--flow-style does not apply to --csv output")
     if args.message_type:
         message_class(args.message_type)  # an unknown type is an error before any waiting
-    accept = _filter(args.filter_expr)
+    accept = message_filter(args.filter_expr)
     limit = None if args.full_length else args.truncate_length
     options = {"no_arr": args.no_arr, "no_str": args.no_str, "truncate_length": limit}
     params = {"topic": args.topic_name, "type": args.message_type, "qos": qos_options(args),

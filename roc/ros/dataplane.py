@@ -14,6 +14,8 @@ from __future__ import annotations
 import base64
 import contextlib
 import queue
+import struct
+import threading
 import time
 from collections.abc import Callable, Iterator
 from typing import Any
@@ -175,7 +177,64 @@ def publish(graph, params: dict[str, Any], prepare: Callable[[], bytes] | None =
         graph.node.destroy_publisher(publisher)
 
 
-STREAMS = {"echo": echo, "publish": publish}
+def header_stamp_ns(data: bytes) -> int | None:
+    """The ``header.stamp`` of a message whose first field is a std_msgs/Header, read from its CDR
+    (encapsulation, then int32 sec and uint32 nanosec) without deserialising it."""
+    if len(data) < 12:
+        return None
+    order = "<" if data[1] & 1 else ">"
+    sec, nanosec = struct.unpack(order + "iI", data[4:12])
+    return sec * 1_000_000_000 + nanosec
+
+
+def stats(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+    """Subscribe to each of ``params["topics"]`` and yield, every ``period`` seconds, a ``batch`` of
+    what arrived: per topic, lists of publication sequence numbers, source and reception timestamps
+    (ns), serialised sizes and, with ``stamps``, header stamps (ns) — never deserialising a message,
+    so that a fast topic does not outrun the subscriber. ``subscribed {topic, type}`` (or
+    ``not_published {topic}``) first, per topic."""
+    period = params.get("period", 1.0)
+    columns = ("sequence", "source", "received", "size", "stamp")
+    arrived: dict[str, dict[str, list]] = {}
+    subscriptions = []
+    lock = threading.Lock()
+
+    def record(topic: str, data: bytes, info: dict) -> None:
+        stamp = header_stamp_ns(data) if params.get("stamps") else None
+        with lock:
+            batch = arrived[topic]
+            batch["sequence"].append(info.get("publication_sequence_number"))
+            batch["source"].append(info.get("source_timestamp"))
+            batch["received"].append(info.get("received_timestamp"))
+            batch["size"].append(len(data))
+            batch["stamp"].append(stamp)
+
+    try:
+        for topic in params["topics"]:
+            found = publishers(graph, topic, params.get("wait", 0.0))
+            if not found:
+                yield {"event": "not_published", "topic": topic}
+            type_name = params.get("type") or next(
+                (types[0] for name, types in graph.node.get_topic_names_and_types() if name == topic), None)
+            if type_name is None:
+                raise RocError(f"Could not determine the type for the passed topic {topic}")
+            arrived[topic] = {column: [] for column in columns}
+            subscriptions.append(graph.node.create_subscription(
+                message_class(type_name), topic, lambda data, info, t=topic: record(t, data, info),
+                qos_profile(params.get("qos", {}), found), raw=True))
+            yield {"event": "subscribed", "topic": topic, "type": type_name}
+        while True:
+            time.sleep(period)
+            with lock:
+                batch = dict(arrived)
+                arrived.update({topic: {column: [] for column in columns} for topic in batch})
+            yield {"event": "batch", "topics": batch}
+    finally:
+        for subscription in subscriptions:
+            graph.node.destroy_subscription(subscription)
+
+
+STREAMS = {"echo": echo, "publish": publish, "stats": stats}
 
 
 def local_stream(method: str, params: dict[str, Any], node_name: str | None = None,
