@@ -37,7 +37,8 @@ def qos(spec: dict) -> QoSProfile:
 
 
 def make_node(spec: dict) -> Node:
-    node = Node(spec["name"], namespace=spec.get("namespace", "/"))
+    node = Node(spec["name"], namespace=spec.get("namespace", "/"),
+                allow_undeclared_parameters=spec.get("undeclared_parameters", False))
     for name, value in spec.get("parameters", {}).items():
         node.declare_parameter(name, value)
     for pub in spec.get("publishers", []):

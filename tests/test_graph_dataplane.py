@@ -20,6 +20,8 @@ TALKER = {"name": "talker", "publishers": [
      "durability": "transient_local", "depth": 1},
     {"topic": "stamped", "type": "std_msgs/msg/Header", "values": {"frame_id": "map"}, "rate_hz": 50,
      "stamp_now": True}]}
+MOTOR = {"name": "motor", "services": [{"name": "~/enable", "type": "std_srvs/srv/SetBool"}],
+         "parameters": {"max_speed": 1.5, "wheels": ["left", "right"]}, "undeclared_parameters": True}
 LISTENER = {"name": "listener", "subscribers": [
     {"topic": "cmd", "type": "geometry_msgs/msg/Twist", "print": True}]}
 
@@ -27,7 +29,7 @@ LISTENER = {"name": "listener", "subscribers": [
 @pytest.fixture(scope="module")
 def graph(tmp_path_factory):
     env = graph_env(80, tmp_path_factory.mktemp("runtime"))
-    processes = start_nodes([[TALKER], [LISTENER]], env)
+    processes = start_nodes([[TALKER], [LISTENER, MOTOR]], env)
     yield env, processes[1]
     stop_daemon(env)
     stop_all(processes)
@@ -170,3 +172,50 @@ def test_hz_bw_and_delay_measure_live_topics(graph) -> None:
     code, out, _ = _run_for(2.5, "topic", "delay", "/stamped", "--format", "json", env=env)
     delay = json.loads(out.splitlines()[-1])
     assert 0 <= delay["min"] <= delay["delay"] <= delay["max"] < 0.5
+
+
+@pytest.mark.parametrize("daemon", [True, False], ids=["daemon", "no-daemon"])
+def test_service_call_prints_request_and_response_as_ros2_does(graph, daemon: bool) -> None:
+    env, _ = graph
+    flags = [] if daemon else ["--no-daemon"]
+    result = roc("service", "call", "/motor/enable", "std_srvs/srv/SetBool", "{data: true}", *flags, env=env)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.removeprefix("waiting for service to become available...\n") == (
+        "requester: making request: std_srvs.srv.SetBool_Request(data=True)\n\n"
+        "response:\nstd_srvs.srv.SetBool_Response(success=False, message='')\n\n")
+    as_json = roc("service", "call", "/motor/enable", "std_srvs/srv/SetBool", "--format", "json", *flags, env=env)
+    assert json.loads(as_json.stdout) == {"service": "/motor/enable", "request": {"data": False},
+                                          "response": {"success": False, "message": ""}}
+    bad = roc("service", "call", "/motor/enable", "std_srvs/srv/SetBool", "{dat: 1}", *flags, env=env)
+    assert (bad.returncode, bad.stdout) == (2, "")
+    assert bad.stderr.startswith("roc: error: dat: std_srvs/srv/SetBool_Request has no field 'dat' (data)")
+
+
+def test_param_set_delete_and_a_dump_loaded_back(graph, tmp_path) -> None:
+    env, _ = graph
+    result = roc("param", "set", "/motor", "max_speed", "2.5", env=env)
+    assert (result.returncode, result.stdout) == (0, "Set parameter successful\n")
+    assert roc("param", "get", "/motor", "max_speed", env=env).stdout == "Double value is: 2.5\n"
+    wrong = roc("param", "set", "/motor", "max_speed", "fast", env=env)
+    assert (wrong.returncode, wrong.stdout) == (
+        1, "Setting parameter failed: Wrong parameter type, expected 'Type.DOUBLE' got 'Type.STRING'\n")
+    several = roc("param", "set", "/motor", "gain", "[1, 2]", "label", "'7'", env=env)
+    assert (several.returncode, several.stdout) == (0, "Set parameter gain successful\nSet parameter label successful\n")
+    assert roc("param", "get", "/motor", "gain", env=env).stdout == "Integer values are: [1, 2]\n"
+    assert roc("param", "get", "/motor", "label", env=env).stdout == "String value is: 7\n"
+    deleted = roc("param", "delete", "/motor", "gain", env=env)
+    assert (deleted.returncode, deleted.stdout) == (0, "Deleted parameter successfully\n")
+    static = roc("param", "delete", "/motor", "max_speed", env=env)
+    assert (static.returncode, static.stdout) == (1, "Deleting parameter failed: Static parameter cannot be undeclared\n")
+
+    dump = tmp_path / "motor.yaml"
+    dump.write_text(roc("param", "dump", "/motor", env=env).stdout.replace("2.5", "3.5"))
+    loaded = roc("param", "load", "/motor", str(dump), env=env)
+    assert loaded.returncode == 0, loaded.stderr
+    assert "Set parameter max_speed successful\n" in loaded.stdout
+    assert "start_type_description_service is read-only on /motor; not set" in loaded.stderr
+    assert roc("param", "get", "/motor", "max_speed", env=env).stdout == "Double value is: 3.5\n"
+    dump.write_text("/motor: {ros__parameters: [1]}\n")
+    broken = roc("param", "load", "/motor", str(dump), env=env)
+    assert (broken.returncode, broken.stderr) == (2, f"roc: error: {dump}: '/motor' has no 'ros__parameters' "
+                                                     "mapping (see 'roc param load --help')\n")

@@ -218,8 +218,8 @@ def query(method: str, params: dict[str, Any] | None = None, *, use_daemon: bool
 def stream(method: str, params: dict[str, Any], *, use_daemon: bool = True,
            **local: Any) -> Iterator[dict[str, Any]]:
     """The events of a streaming request (roc.ros.dataplane), in the daemon unless ``use_daemon`` is
-    false (``local``: options of roc.ros.dataplane.local_stream); closing the iterator (or Ctrl+C) ends
-    the stream and removes its endpoint."""
+    false (``local``: options of roc.ros.dataplane.local_stream), or in this process when the daemon
+    cannot import the type; closing the iterator (or Ctrl+C) ends the stream and removes its endpoint."""
     if not use_daemon:
         from roc.ros.dataplane import local_stream
 
@@ -228,10 +228,18 @@ def stream(method: str, params: dict[str, Any], *, use_daemon: bool = True,
         return
     connection = start_daemon()
     try:
+        started = False
         for response in connection.stream(method, params):
-            if "error" in response:
-                raise DaemonError(response["error"]["message"])
+            error = response.get("error")
+            if error and error.get("kind") == "UnknownTypeError" and not started:
+                break  # a type the daemon's environment lacks (an overlay sourced since it started)
+            if error:
+                raise DaemonError(error["message"])
             if response.get("event") not in (None, "heartbeat"):
+                started = True
                 yield response
+        else:
+            return
     finally:
         connection.close()
+    yield from stream(method, params, use_daemon=False, **local)

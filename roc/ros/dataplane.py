@@ -31,7 +31,7 @@ from rclpy.qos import (
 from rclpy.serialization import deserialize_message, serialize_message
 
 from roc.errors import RocError
-from roc.ros.types import message_class
+from roc.ros.types import message_class, service_class
 
 HEARTBEAT_SECONDS = 0.5
 POLL_SECONDS = 0.05
@@ -65,9 +65,11 @@ def qos_profile(options: dict[str, Any], publishers: list | None = None) -> QoSP
     return profile
 
 
-def decode(type_name: str, data: str) -> Any:
-    """A message object from the base64 CDR of an ``echo`` event."""
-    return deserialize_message(base64.b64decode(data), message_class(type_name))
+def decode(message_type: str | type, data: str) -> Any:
+    """A message object (a message type's name, or a class such as a service's Response) from base64
+    CDR, as stream events carry messages."""
+    cls = message_class(message_type) if isinstance(message_type, str) else message_type
+    return deserialize_message(base64.b64decode(data), cls)
 
 
 def serialize(message: Any) -> bytes:
@@ -91,6 +93,10 @@ def publishers(graph, topic: str, wait: float) -> list:
         time.sleep(POLL_SECONDS)
 
 
+def _graph_type(graph, topic: str) -> str | None:
+    return next((types[0] for name, types in graph.node.get_topic_names_and_types() if name == topic), None)
+
+
 def echo(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
     """Subscribe to ``params["topic"]`` and yield ``{"event": "message", "data", "info", "lost"}`` per
     message (``lost``: messages the publisher's sequence numbers say never arrived), ``{"event":
@@ -99,13 +105,12 @@ def echo(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
     first message; then ``{"event": "timeout"}`` ends the stream)."""
     topic = params["topic"]
     found = publishers(graph, topic, params.get("wait", 0.0))
+    type_name = params.get("type") or _graph_type(graph, topic)
+    cls = message_class(type_name) if type_name else None  # before any event: see client.stream
     if not found:
         yield {"event": "not_published"}
-    type_name = params.get("type") or next(
-        (types[0] for name, types in graph.node.get_topic_names_and_types() if name == topic), None)
-    if type_name is None:
+    if cls is None:
         raise RocError("Could not determine the type for the passed topic")
-    cls = message_class(type_name)
     profile = qos_profile(params.get("qos", {}), found)
     arrived: queue.SimpleQueue = queue.SimpleQueue()
     subscription = graph.node.create_subscription(
@@ -212,15 +217,15 @@ def stats(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
     try:
         for topic in params["topics"]:
             found = publishers(graph, topic, params.get("wait", 0.0))
+            type_name = params.get("type") or _graph_type(graph, topic)
+            cls = message_class(type_name) if type_name else None
             if not found:
                 yield {"event": "not_published", "topic": topic}
-            type_name = params.get("type") or next(
-                (types[0] for name, types in graph.node.get_topic_names_and_types() if name == topic), None)
-            if type_name is None:
+            if cls is None:
                 raise RocError(f"Could not determine the type for the passed topic {topic}")
             arrived[topic] = {column: [] for column in columns}
             subscriptions.append(graph.node.create_subscription(
-                message_class(type_name), topic, lambda data, info, t=topic: record(t, data, info),
+                cls, topic, lambda data, info, t=topic: record(t, data, info),
                 qos_profile(params.get("qos", {}), found), raw=True))
             yield {"event": "subscribed", "topic": topic, "type": type_name}
         while True:
@@ -234,7 +239,42 @@ def stats(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
             graph.node.destroy_subscription(subscription)
 
 
-STREAMS = {"echo": echo, "publish": publish, "stats": stats}
+def _wait(done: Callable[[], bool]) -> Iterator[dict[str, Any]]:
+    """Heartbeats until ``done()``."""
+    while not done():
+        yield {"event": "heartbeat"}
+
+
+def call(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+    """Call ``params["service"]`` (a ``type`` service) with ``request`` (base64 CDR): ``waiting`` while
+    no server is available, then ``request`` and ``response {data}`` per call; with ``rate`` (Hz) again
+    and again until closed."""
+    cls = service_class(params["type"])
+    request = deserialize_message(base64.b64decode(params["request"]), cls.Request)
+    client = graph.node.create_client(cls, params["service"])
+    try:
+        if not client.wait_for_service(timeout_sec=0.1):
+            yield {"event": "waiting"}
+            yield from _wait(lambda: client.wait_for_service(timeout_sec=HEARTBEAT_SECONDS))
+        period, due = 1.0 / params["rate"] if params.get("rate") else None, time.monotonic()
+        while True:
+            yield {"event": "request"}
+            answered = threading.Event()
+            future = client.call_async(request)
+            future.add_done_callback(lambda _: answered.set())
+            yield from _wait(lambda: answered.wait(HEARTBEAT_SECONDS))
+            yield {"event": "response", "data": base64.b64encode(serialize(future.result())).decode()}
+            if period is None:
+                return
+            due += period
+            while (remaining := due - time.monotonic()) > 0:
+                time.sleep(min(remaining, HEARTBEAT_SECONDS))
+                yield {"event": "heartbeat"}
+    finally:
+        graph.node.destroy_client(client)
+
+
+STREAMS = {"echo": echo, "publish": publish, "stats": stats, "call": call}
 
 
 def local_stream(method: str, params: dict[str, Any], node_name: str | None = None,
