@@ -14,10 +14,13 @@ from __future__ import annotations
 import importlib
 import json
 import sys
+import time
 
 import rclpy
 from rclpy.duration import Duration
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.action import CancelResponse
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
@@ -65,14 +68,36 @@ def make_node(spec: dict) -> Node:
         from rclpy.action import ActionServer
 
         node._roc_action = ActionServer(node, load(action.get("type", "test_msgs/action/Fibonacci")),
-                                        action["name"], lambda goal: None)
+                                        action["name"], fibonacci(action.get("step_seconds", 0.0)),
+                                        callback_group=ReentrantCallbackGroup(),
+                                        cancel_callback=lambda _goal: CancelResponse.ACCEPT)
     return node
+
+
+def fibonacci(step_seconds: float):
+    """A test_msgs/action/Fibonacci server: feedback after each number, ``step_seconds`` apart; a
+    canceled goal ends canceled, and prints ``canceled``."""
+    def execute(goal_handle):
+        from test_msgs.action import Fibonacci
+
+        sequence = [0, 1]
+        for _ in range(max(0, goal_handle.request.order - 1)):
+            if goal_handle.is_cancel_requested:
+                goal_handle.canceled()
+                print("canceled", flush=True)
+                return Fibonacci.Result(sequence=sequence)
+            sequence.append(sequence[-1] + sequence[-2])
+            goal_handle.publish_feedback(Fibonacci.Feedback(sequence=sequence))
+            time.sleep(step_seconds)
+        goal_handle.succeed()
+        return Fibonacci.Result(sequence=sequence)
+    return execute
 
 
 def main() -> None:
     specs = json.loads(sys.argv[1])
     rclpy.init()
-    executor = SingleThreadedExecutor()
+    executor = MultiThreadedExecutor()  # an action's execute callback may run while others are served
     for spec in specs if isinstance(specs, list) else [specs]:
         executor.add_node(make_node(spec))
     print("ready", flush=True)

@@ -21,6 +21,7 @@ TALKER = {"name": "talker", "publishers": [
     {"topic": "stamped", "type": "std_msgs/msg/Header", "values": {"frame_id": "map"}, "rate_hz": 50,
      "stamp_now": True}]}
 MOTOR = {"name": "motor", "services": [{"name": "~/enable", "type": "std_srvs/srv/SetBool"}],
+         "actions": [{"name": "fibonacci", "step_seconds": 0.2}],
          "parameters": {"max_speed": 1.5, "wheels": ["left", "right"]}, "undeclared_parameters": True}
 LISTENER = {"name": "listener", "subscribers": [
     {"topic": "cmd", "type": "geometry_msgs/msg/Twist", "print": True}]}
@@ -75,7 +76,7 @@ def _received(listener: subprocess.Popen, count: int, timeout: float = 10.0) -> 
     lines, deadline = [], time.monotonic() + timeout
     while len(lines) < count and time.monotonic() < deadline:
         line = listener.stdout.readline()
-        if line:
+        if line.startswith("{"):  # (the action server in the same process prints "canceled")
             lines.append(json.loads(line)["message"])
     return lines
 
@@ -219,3 +220,43 @@ def test_param_set_delete_and_a_dump_loaded_back(graph, tmp_path) -> None:
     broken = roc("param", "load", "/motor", str(dump), env=env)
     assert (broken.returncode, broken.stderr) == (2, f"roc: error: {dump}: '/motor' has no 'ros__parameters' "
                                                      "mapping (see 'roc param load --help')\n")
+
+
+@pytest.mark.parametrize("daemon", [True, False], ids=["daemon", "no-daemon"])
+def test_send_goal_with_feedback_and_result(graph, daemon: bool) -> None:
+    env, _ = graph
+    flags = [] if daemon else ["--no-daemon"]
+    result = roc("action", "send_goal", "/fibonacci", "test_msgs/action/Fibonacci", "{order: 2}", "-f", *flags, env=env)
+    assert result.returncode == 0, result.stderr
+    text = result.stdout.removeprefix("Waiting for an action server to become available...\n")
+    head, _, rest = text.partition("Goal accepted with ID: ")
+    assert head == "Sending goal:\n     order: 2\n\n"
+    goal_id, _, rest = rest.partition("\n\n")
+    assert len(bytes.fromhex(goal_id)) == 16
+    assert rest == ("Feedback:\n    sequence:\n- 0\n- 1\n- 1\n\n"
+                    "Result:\n    sequence:\n- 0\n- 1\n- 1\n\nGoal finished with status: SUCCEEDED\n")
+    as_json = roc("action", "send_goal", "/fibonacci", "test_msgs/action/Fibonacci", "{order: 2}", "--format", "json",
+                  *flags, env=env)
+    line = json.loads(as_json.stdout)
+    assert (line["status"], line["result"]) == ("SUCCEEDED", {"sequence": [0, 1, 1]})
+
+
+def test_ctrl_c_cancels_the_goal_and_says_so(graph) -> None:
+    env, listener = graph
+    goal = subprocess.Popen([str(BIN / "roc"), "action", "send_goal", "/fibonacci", "test_msgs/action/Fibonacci",
+                             "{order: 40}"], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        lines = []
+        while not any(line.startswith("Goal accepted") for line in lines):
+            lines.append(goal.stdout.readline())
+        goal.send_signal(signal.SIGINT)
+        out, _ = goal.communicate(timeout=20)
+    finally:
+        stop_process(goal)
+    assert goal.returncode == 130
+    assert out.endswith("Canceling goal...\nGoal canceled.\n")
+    deadline = time.monotonic() + 10
+    printed = ""
+    while "canceled" not in printed and time.monotonic() < deadline:  # what the server says (one process with MOTOR)
+        printed = listener.stdout.readline()
+    assert "canceled" in printed

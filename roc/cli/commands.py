@@ -52,6 +52,7 @@ COMMANDS = (
     (("action", "list"), (), "action_list", "list the actions of the ROS graph"),
     (("action", "info"), (), "action_info", "the servers and clients of an action"),
     (("action", "type"), (), "action_type", "print an action's type"),
+    (("action", "send_goal"), (), "action_send_goal", "send a goal to an action server and wait for its result"),
     (("param",), (), None, "ROS parameters: list, get, describe, dump, set, delete, load"),
     (("param", "list"), (), "param_list", "list the parameters of one node or of every node"),
     (("param", "get"), (), "param_get", "print a parameter's value"),

@@ -215,16 +215,18 @@ def query(method: str, params: dict[str, Any] | None = None, *, use_daemon: bool
         connection.close()
 
 
-def stream(method: str, params: dict[str, Any], *, use_daemon: bool = True,
+def stream(method: str, params: dict[str, Any], *, use_daemon: bool = True, heartbeats: bool = False,
            **local: Any) -> Iterator[dict[str, Any]]:
     """The events of a streaming request (roc.ros.dataplane), in the daemon unless ``use_daemon`` is
     false (``local``: options of roc.ros.dataplane.local_stream), or in this process when the daemon
-    cannot import the type; closing the iterator (or Ctrl+C) ends the stream and removes its endpoint."""
+    cannot import the type; closing the iterator (or Ctrl+C) ends the stream and removes its endpoint.
+    ``heartbeats``: pass on the heartbeat events too (at least every 0.5 s, to act between events)."""
+    skipped = () if heartbeats else ("heartbeat",)
     if not use_daemon:
         from roc.ros.dataplane import local_stream
 
         events = local_stream(method, params, **local)
-        yield from (event for event in events if event.get("event") != "heartbeat")
+        yield from (event for event in events if event.get("event") not in skipped)
         return
     connection = start_daemon()
     try:
@@ -235,11 +237,11 @@ def stream(method: str, params: dict[str, Any], *, use_daemon: bool = True,
                 break  # a type the daemon's environment lacks (an overlay sourced since it started)
             if error:
                 raise DaemonError(error["message"])
-            if response.get("event") not in (None, "heartbeat"):
+            if response.get("event") is not None and response["event"] not in skipped:
                 started = True
                 yield response
         else:
             return
     finally:
         connection.close()
-    yield from stream(method, params, use_daemon=False, **local)
+    yield from stream(method, params, use_daemon=False, heartbeats=heartbeats, **local)

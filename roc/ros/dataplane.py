@@ -31,7 +31,7 @@ from rclpy.qos import (
 from rclpy.serialization import deserialize_message, serialize_message
 
 from roc.errors import RocError
-from roc.ros.types import message_class, service_class
+from roc.ros.types import action_class, message_class, service_class
 
 HEARTBEAT_SECONDS = 0.5
 POLL_SECONDS = 0.05
@@ -259,10 +259,8 @@ def call(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
         period, due = 1.0 / params["rate"] if params.get("rate") else None, time.monotonic()
         while True:
             yield {"event": "request"}
-            answered = threading.Event()
             future = client.call_async(request)
-            future.add_done_callback(lambda _: answered.set())
-            yield from _wait(lambda: answered.wait(HEARTBEAT_SECONDS))
+            yield from _wait(lambda: _done(future))
             yield {"event": "response", "data": base64.b64encode(serialize(future.result())).decode()}
             if period is None:
                 return
@@ -274,7 +272,65 @@ def call(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
         graph.node.destroy_client(client)
 
 
-STREAMS = {"echo": echo, "publish": publish, "stats": stats, "call": call}
+GOAL_STATUS = {0: "UNKNOWN", 1: "ACCEPTED", 2: "EXECUTING", 3: "CANCELING", 4: "SUCCEEDED", 5: "CANCELED",
+               6: "ABORTED"}
+
+
+def goal(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+    """Send ``params["goal"]`` (base64 CDR of a ``type`` action's Goal) to ``action``: ``waiting``
+    while no server is available, then ``accepted {goal_id}`` (or ``rejected``), ``feedback {data}``
+    (with ``feedback``), and ``result {data, status}``. Closed before the result, the goal is
+    canceled."""
+    from rclpy.action import ActionClient
+
+    cls = action_class(params["type"])
+    request = deserialize_message(base64.b64decode(params["goal"]), cls.Goal)
+    client = ActionClient(graph.node, cls, params["action"])
+    handle = None
+    try:
+        if not client.wait_for_server(timeout_sec=0.1):
+            yield {"event": "waiting"}
+            yield from _wait(lambda: client.wait_for_server(timeout_sec=HEARTBEAT_SECONDS))
+        feedback: queue.SimpleQueue = queue.SimpleQueue()
+        sent = client.send_goal_async(request, feedback_callback=feedback.put if params.get("feedback") else None)
+        yield from _wait(lambda: _done(sent))
+        handle = sent.result()
+        if not handle.accepted:
+            handle = None
+            yield {"event": "rejected"}
+            return
+        yield {"event": "accepted", "goal_id": bytes(handle.goal_id.uuid).hex()}
+        result = handle.get_result_async()
+        while True:
+            finished = _done(result)
+            while not feedback.empty():
+                message = feedback.get().feedback
+                yield {"event": "feedback", "data": base64.b64encode(serialize(message)).decode()}
+            if finished:
+                break
+            yield {"event": "heartbeat"}
+        outcome = result.result()
+        handle = None
+        yield {"event": "result", "data": base64.b64encode(serialize(outcome.result)).decode(),
+               "status": GOAL_STATUS.get(outcome.status, "UNKNOWN")}
+    finally:
+        if handle is not None:  # the client went away first: do not leave the goal running
+            canceled = threading.Event()
+            handle.cancel_goal_async().add_done_callback(lambda _: canceled.set())
+            canceled.wait(2.0)
+        client.destroy()
+
+
+def _done(future) -> bool:
+    """Whether ``future`` (completed by the Graph's executor thread) is done, waiting up to a
+    heartbeat for it."""
+    deadline = time.monotonic() + HEARTBEAT_SECONDS
+    while not future.done() and time.monotonic() < deadline:
+        time.sleep(0.005)
+    return future.done()
+
+
+STREAMS = {"echo": echo, "publish": publish, "stats": stats, "call": call, "goal": goal}
 
 
 def local_stream(method: str, params: dict[str, Any], node_name: str | None = None,
