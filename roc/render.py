@@ -31,11 +31,14 @@ def print_json(data: Any, stream: TextIO | None = None) -> None:
     out.write("\n")
 
 
+def json_line(data: Any) -> str:
+    """One compact JSON object and a newline."""
+    return json.dumps(data, separators=(",", ":")) + "\n"
+
+
 def print_json_line(data: Any, stream: TextIO | None = None) -> None:
     """One compact JSON object on one line, flushed (for streams: events, messages, status)."""
-    out = stream or sys.stdout
-    out.write(json.dumps(data, separators=(",", ":")) + "\n")
-    out.flush()
+    print_text(json_line(data), stream)
 
 
 def to_yaml(data: Any, flow_style: bool | None = False) -> str:

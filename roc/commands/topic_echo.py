@@ -3,16 +3,20 @@
 from __future__ import annotations
 
 import argparse
+import base64
 import sys
 
 from roc.cli.options import add_graph_arguments, add_qos_arguments, qos_options
 from roc.errors import RocError, UsageError
-from roc.render import print_json_line, print_text
+from roc.render import json_line, print_text
 from roc.ros.client import stream
 from roc.ros.messages import echo_text, get_field, value_to_data
 from roc.ros.types import message_class
 
 DEFAULT_TRUNCATE_LENGTH = 128
+# ros2 subscribes with the sensor_data depth, 5: a burst larger than that is lost while the terminal
+# catches up. roc keeps the last 1000 (--qos-depth sets another).
+DEFAULT_DEPTH = 1000
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -66,7 +70,10 @@ def run(args: argparse.Namespace) -> int:
     accept = message_filter(args.filter_expr)
     limit = None if args.full_length else args.truncate_length
     options = {"no_arr": args.no_arr, "no_str": args.no_str, "truncate_length": limit}
-    params = {"topic": args.topic_name, "type": args.message_type, "qos": qos_options(args),
+    qos = qos_options(args)
+    if qos["depth"] is None and args.qos_history != "keep_all":
+        qos["depth"] = DEFAULT_DEPTH
+    params = {"topic": args.topic_name, "type": args.message_type, "qos": qos,
               "wait": args.spin_time if args.spin_time is not None else 3.5 if args.no_daemon else 0.0,
               "timeout": args.timeout}
     lost_total = 0
@@ -79,36 +86,41 @@ def run(args: argparse.Namespace) -> int:
             type_name = event["type"]
         elif kind == "timeout":
             raise RocError(f"no message on {args.topic_name} within {args.timeout:g} s (--timeout)")
-        elif kind == "message":
-            if event["lost"] and not args.no_lost_messages:
-                lost_total += event["lost"]
-                print_text(f"A message was lost!!!\n\ttotal count change:{event['lost']}\n\ttotal count: "
-                           f"{lost_total}\n", sys.stderr)
-            if _print_message(event, type_name, args, accept, options) and args.once:
+        elif kind == "messages":
+            texts = []  # a backlog is written at once
+            for message in event["messages"]:
+                if message["lost"] and not args.no_lost_messages:
+                    lost_total += message["lost"]
+                    print_text(f"A message was lost!!!\n\ttotal count change:{message['lost']}\n\ttotal count: "
+                               f"{lost_total}\n", sys.stderr)
+                text = _message_text(message, type_name, args, accept, options)
+                if text is not None:
+                    texts.append(text)
+                    if args.once:
+                        break
+            print_text("".join(texts))
+            if args.once and texts:
                 return 0
     return 0
 
 
-def _print_message(event: dict, type_name: str, args: argparse.Namespace, accept, options: dict) -> bool:
-    """Print one message as asked; False when --filter rejected it."""
+def _message_text(event: dict, type_name: str, args: argparse.Namespace, accept, options: dict) -> str | None:
+    """One message as asked; None when --filter rejects it."""
     from roc.ros.dataplane import decode
 
     if args.raw:
-        import base64
-
         value = base64.b64decode(event["data"])
     else:
         message = decode(type_name, event["data"])
         if accept is not None and not accept(message):
-            return False
+            return None
         value = get_field(message, args.field) if args.field else message
     if args.format == "json":
         data = list(value) if args.raw else value_to_data(value, **options)
-        print_json_line({"topic": args.topic_name, "type": type_name, "message": data, "lost": event["lost"],
-                         **({"info": event["info"]} if args.include_message_info else {})})
-        return True
+        return json_line({"topic": args.topic_name, "type": type_name, "message": data, "lost": event["lost"],
+                          **({"info": event["info"]} if args.include_message_info else {})})
+    text = echo_text(value, csv=args.csv, flow_style=args.flow_style, **options)
     if args.include_message_info:
         info = "".join(f"{key}: {value}\n" for key, value in event["info"].items())
-        print_text(f"---Got new message, message info:---\n{info}")
-    print_text(echo_text(value, csv=args.csv, flow_style=args.flow_style, **options))
-    return True
+        return f"---Got new message, message info:---\n{info}{text}"
+    return text

@@ -82,13 +82,14 @@ def _filtered(args: argparse.Namespace, topic: str, accept, wait: float):
         elif event["event"] == "subscribed":
             type_name = event["type"]
             yield {"event": "subscribed", "topic": topic, "type": type_name}
-        elif event["event"] == "message":
-            data = base64.b64decode(event["data"])
-            if accept(decode(type_name, event["data"])):
-                info = event["info"]
-                for column, value in zip(columns, (info.get("publication_sequence_number"), info.get("source_timestamp"),
-                                                   info.get("received_timestamp"), len(data), None)):
-                    batch[column].append(value)
+        elif event["event"] == "messages":
+            for message in event["messages"]:
+                if accept(decode(type_name, message["data"])):
+                    info = message["info"]
+                    for column, value in zip(columns, (
+                            info.get("publication_sequence_number"), info.get("source_timestamp"),
+                            info.get("received_timestamp"), len(base64.b64decode(message["data"])), None)):
+                        batch[column].append(value)
         if time.monotonic() >= due:
             yield {"event": "batch", "topics": {topic: batch}}
             batch, due = {column: [] for column in columns}, due + 1.0

@@ -34,6 +34,7 @@ from roc.errors import RocError
 from roc.ros.types import action_class, message_class, service_class
 
 HEARTBEAT_SECONDS = 0.5
+MAX_BATCH = 1000  # messages in one ``messages`` event
 POLL_SECONDS = 0.05
 _POLICIES = {"history": HistoryPolicy, "reliability": ReliabilityPolicy, "durability": DurabilityPolicy,
              "liveliness": LivelinessPolicy}
@@ -97,24 +98,38 @@ def _graph_type(graph, topic: str) -> str | None:
     return next((types[0] for name, types in graph.node.get_topic_names_and_types() if name == topic), None)
 
 
-def echo(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
-    """Subscribe to ``params["topic"]`` and yield ``{"event": "message", "data", "info", "lost"}`` per
-    message (``lost``: messages the publisher's sequence numbers say never arrived), ``{"event":
-    "subscribed", "type"}`` first and heartbeats in between. Params: ``topic``, ``wait`` (seconds to
-    wait for a publisher to be discovered), ``type`` (else the graph's), ``qos`` (see qos_profile), ``timeout`` (seconds for the
-    first message; then ``{"event": "timeout"}`` ends the stream)."""
-    topic = params["topic"]
+def _topic_class(graph, topic: str, params: dict[str, Any], wait_for_type: bool):
+    """Events while the topic's publishers and type are looked up (``not_published {topic}``, and
+    heartbeats while waiting for a type with ``wait_for_type``); returns (class, type name, publishers).
+    The type is resolved before any event, so that a type the daemon lacks is found first (client.stream)."""
     found = publishers(graph, topic, params.get("wait", 0.0))
     type_name = params.get("type") or _graph_type(graph, topic)
-    cls = message_class(type_name) if type_name else None  # before any event: see client.stream
+    cls = message_class(type_name) if type_name else None
     if not found:
-        yield {"event": "not_published"}
+        yield {"event": "not_published", "topic": topic}
+    while cls is None and wait_for_type:  # as ros2 topic hz: until the topic appears
+        yield {"event": "heartbeat"}
+        time.sleep(POLL_SECONDS)
+        type_name = _graph_type(graph, topic)
+        cls = message_class(type_name) if type_name else None
+        found = graph.node.get_publishers_info_by_topic(topic)
     if cls is None:
         raise RocError("Could not determine the type for the passed topic")
-    profile = qos_profile(params.get("qos", {}), found)
+    return cls, type_name, found
+
+
+def echo(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+    """Subscribe to ``params["topic"]`` and yield ``{"event": "messages", "messages": [{data, info,
+    lost}]}`` with what arrived since the last event (``lost``: messages the publisher's sequence
+    numbers say never arrived), ``{"event": "subscribed", "type"}`` first and heartbeats in between.
+    Params: ``topic``, ``wait`` (seconds to wait for a publisher to be discovered), ``type`` (else the
+    graph's), ``qos`` (see qos_profile), ``timeout`` (seconds for the first message; then ``{"event":
+    "timeout"}`` ends the stream)."""
+    topic = params["topic"]
+    cls, type_name, found = yield from _topic_class(graph, topic, params, wait_for_type=False)
     arrived: queue.SimpleQueue = queue.SimpleQueue()
     subscription = graph.node.create_subscription(
-        cls, topic, lambda data, info: arrived.put((data, info)), profile, raw=True)
+        cls, topic, lambda data, info: arrived.put((data, info)), qos_profile(params.get("qos", {}), found), raw=True)
     try:
         yield {"event": "subscribed", "type": type_name}
         last_sequence: int | None = None
@@ -122,7 +137,7 @@ def echo(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
         deadline = time.monotonic() + timeout if timeout is not None else None
         while True:
             try:
-                data, info = arrived.get(timeout=HEARTBEAT_SECONDS)
+                batch = [arrived.get(timeout=HEARTBEAT_SECONDS)]
             except queue.Empty:
                 if deadline is not None and time.monotonic() >= deadline:
                     yield {"event": "timeout"}
@@ -130,13 +145,18 @@ def echo(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
                 yield {"event": "heartbeat"}
                 continue
             deadline = None  # a message arrived: the timeout is over
-            sequence = info.get("publication_sequence_number")
-            lost = 0
-            if sequence is not None and last_sequence is not None and sequence > last_sequence + 1:
-                lost = sequence - last_sequence - 1  # a lower number: another publisher, nothing lost
-            last_sequence = sequence
-            yield {"event": "message", "data": base64.b64encode(data).decode(), "lost": lost,
-                   "info": {key: value for key, value in info.items() if value is not None}}
+            while len(batch) < MAX_BATCH and not arrived.empty():  # a backlog goes as one event
+                batch.append(arrived.get())
+            messages = []
+            for data, info in batch:
+                sequence = info.get("publication_sequence_number")
+                lost = 0
+                if sequence is not None and last_sequence is not None and sequence > last_sequence + 1:
+                    lost = sequence - last_sequence - 1  # a lower number: another publisher, nothing lost
+                last_sequence = sequence
+                messages.append({"data": base64.b64encode(data).decode(), "lost": lost,
+                                 "info": {key: value for key, value in info.items() if value is not None}})
+            yield {"event": "messages", "messages": messages}
     finally:
         graph.node.destroy_subscription(subscription)
 
@@ -197,7 +217,7 @@ def stats(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
     what arrived: per topic, lists of publication sequence numbers, source and reception timestamps
     (ns), serialised sizes and, with ``stamps``, header stamps (ns) — never deserialising a message,
     so that a fast topic does not outrun the subscriber. ``subscribed {topic, type}`` (or
-    ``not_published {topic}``) first, per topic."""
+    ``not_published {topic}``, then heartbeats until the topic appears) first, per topic."""
     period = params.get("period", 1.0)
     columns = ("sequence", "source", "received", "size", "stamp")
     arrived: dict[str, dict[str, list]] = {}
@@ -216,13 +236,7 @@ def stats(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
 
     try:
         for topic in params["topics"]:
-            found = publishers(graph, topic, params.get("wait", 0.0))
-            type_name = params.get("type") or _graph_type(graph, topic)
-            cls = message_class(type_name) if type_name else None
-            if not found:
-                yield {"event": "not_published", "topic": topic}
-            if cls is None:
-                raise RocError(f"Could not determine the type for the passed topic {topic}")
+            cls, type_name, found = yield from _topic_class(graph, topic, params, wait_for_type=True)
             arrived[topic] = {column: [] for column in columns}
             subscriptions.append(graph.node.create_subscription(
                 cls, topic, lambda data, info, t=topic: record(t, data, info),
