@@ -10,7 +10,7 @@ import time
 
 import pytest
 from build_helpers import BIN, stop_process
-from graph_helpers import graph_env, roc, start_nodes, stop_all, stop_daemon
+from graph_helpers import graph_env, install_oracle, roc, ros2, start_nodes, stop_all, stop_daemon
 
 pytestmark = pytest.mark.slow
 
@@ -198,8 +198,8 @@ def test_param_set_delete_and_a_dump_loaded_back(graph, tmp_path) -> None:
     assert (result.returncode, result.stdout) == (0, "Set parameter successful\n")
     assert roc("param", "get", "/motor", "max_speed", env=env).stdout == "Double value is: 2.5\n"
     wrong = roc("param", "set", "/motor", "max_speed", "fast", env=env)
-    assert (wrong.returncode, wrong.stdout) == (
-        1, "Setting parameter failed: Wrong parameter type, expected 'Type.DOUBLE' got 'Type.STRING'\n")
+    assert (wrong.returncode, wrong.stdout, wrong.stderr) == (
+        1, "", "Setting parameter failed: Wrong parameter type, expected 'Type.DOUBLE' got 'Type.STRING'\n")
     several = roc("param", "set", "/motor", "gain", "[1, 2]", "label", "'7'", env=env)
     assert (several.returncode, several.stdout) == (0, "Set parameter gain successful\nSet parameter label successful\n")
     assert roc("param", "get", "/motor", "gain", env=env).stdout == "Integer values are: [1, 2]\n"
@@ -207,7 +207,7 @@ def test_param_set_delete_and_a_dump_loaded_back(graph, tmp_path) -> None:
     deleted = roc("param", "delete", "/motor", "gain", env=env)
     assert (deleted.returncode, deleted.stdout) == (0, "Deleted parameter successfully\n")
     static = roc("param", "delete", "/motor", "max_speed", env=env)
-    assert (static.returncode, static.stdout) == (1, "Deleting parameter failed: Static parameter cannot be undeclared\n")
+    assert (static.returncode, static.stderr) == (1, "Deleting parameter failed: Static parameter cannot be undeclared\n")
 
     dump = tmp_path / "motor.yaml"
     dump.write_text(roc("param", "dump", "/motor", env=env).stdout.replace("2.5", "3.5"))
@@ -260,3 +260,38 @@ def test_ctrl_c_cancels_the_goal_and_says_so(graph) -> None:
     while "canceled" not in printed and time.monotonic() < deadline:  # what the server says (one process with MOTOR)
         printed = listener.stdout.readline()
     assert "canceled" in printed
+
+
+def _without_waiting(text: str) -> str:
+    """Output without the lines both tools print only while discovery is under way."""
+    return "\n".join(line for line in text.split("\n") if not line.startswith(("Waiting for", "waiting for",
+                                                                            "WARNING: topic")))
+
+
+def test_the_ros2_cli_prints_the_same(graph) -> None:
+    reason = install_oracle()
+    if reason:
+        pytest.skip(f"the ros2 CLI oracle is not available: {reason}")
+    env, _ = graph
+    commands = [
+        ("topic", "echo", "/latched", "--once"),
+        ("topic", "echo", "/chatter", "std_msgs/msg/String", "--once", "--field", "data"),
+        ("topic", "echo", "/latched", "--once", "--csv"),
+        ("topic", "pub", "--once", "/cmd", "geometry_msgs/msg/Twist", "{linear: {x: 0.25}}"),
+        ("service", "call", "/motor/enable", "std_srvs/srv/SetBool", "{data: true}"),
+        ("param", "set", "/motor", "max_speed", "1.75"),
+    ]
+    for command in commands:
+        ours, theirs = roc(*command, env=env), ros2(*command, env=env)
+        assert (ours.returncode, _without_waiting(ours.stdout)) == (theirs.returncode, _without_waiting(theirs.stdout)), command
+    refused = ("param", "set", "/motor", "max_speed", "fast")  # ros2 exits 0 here; roc exits 1
+    ours, theirs = roc(*refused, env=env), ros2(*refused, env=env)
+    assert (ours.returncode, ours.stdout, ours.stderr) == (1, theirs.stdout, theirs.stderr)
+    goal = ("action", "send_goal", "/fibonacci", "test_msgs/action/Fibonacci", "{order: 3}", "-f")
+    ours, theirs = roc(*goal, env=env), ros2(*goal, env=env)
+    assert ours.returncode == theirs.returncode == 0, theirs.stderr
+
+    def without_goal_id(text: str) -> str:
+        return "\n".join("Goal accepted with ID: ..." if line.startswith("Goal accepted with ID: ") else line
+                         for line in _without_waiting(text).split("\n"))
+    assert without_goal_id(ours.stdout) == without_goal_id(theirs.stdout)

@@ -5,8 +5,7 @@ from __future__ import annotations
 import argparse
 
 from roc.cli.options import add_graph_arguments
-from roc.commands.param_set import set_parameters
-from roc.render import render
+from roc.commands.param_set import report, set_parameters
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -19,7 +18,4 @@ def run(args: argparse.Namespace) -> int:
     """Exit 1 when the node refused (a declared, statically typed parameter cannot be deleted)."""
     results = set_parameters(args, args.node_name, [{"name": name, "type": "not set", "value": None}
                                                     for name in args.parameter_names])
-    lines = ["Deleted parameter successfully" if r["successful"] else
-             "Deleting parameter failed" + (f": {r['reason']}" if r["reason"] else "") for r in results]
-    render(results, args.format, lines)
-    return 0 if all(r["successful"] for r in results) else 1
+    return report(args, results, lambda _: "Deleted parameter successfully", lambda _: "Deleting parameter failed")

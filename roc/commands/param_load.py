@@ -10,10 +10,9 @@ from typing import Any
 import yaml
 
 from roc.cli.options import add_graph_arguments
-from roc.commands.param_set import result_lines, set_parameters, typed_value
+from roc.commands.param_set import report, set_parameters, typed_value
 from roc.errors import UsageError
 from roc.messages import warn
-from roc.render import render
 from roc.ros.client import query
 
 
@@ -71,5 +70,5 @@ def run(args: argparse.Namespace) -> int:
         warn(f"{args.parameter_file}: {name} is read-only on {args.node_name}; not set")
     results = set_parameters(args, args.node_name, [{"name": name, **typed_value(value)}
                                                     for name, value in values.items() if name not in read_only])
-    render(results, args.format, result_lines(results))
-    return 0 if all(r["successful"] for r in results) else 1
+    return report(args, results, lambda name: f"Set parameter {name} successful",
+                  lambda name: f"Set parameter {name} failed")

@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import argparse
+import sys
+from collections.abc import Callable
 from typing import Any
 
 import yaml
 
 from roc.cli.options import add_graph_arguments
 from roc.errors import UsageError
-from roc.render import render
+from roc.render import print_lines, render
 from roc.ros.client import query
 
 ARRAY_TYPES = ((bool, "boolean array"), (int, "integer array"), (float, "double array"), (str, "string array"))
@@ -54,22 +56,23 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_graph_arguments(parser)
 
 
-def result_lines(results: list[dict[str, Any]]) -> list[str]:
-    """ros2's line for each parameter of a ``param set`` or ``param load``."""
-    return [f"Set parameter {r['name']} successful" if r["successful"] else
-            f"Set parameter {r['name']} failed" + (f": {r['reason']}" if r["reason"] else "") for r in results]
+def report(args: argparse.Namespace, results: list[dict[str, Any]], succeeded: Callable[[str], str],
+           failed: Callable[[str], str]) -> int:
+    """ros2's line per parameter (``succeeded(name)``; ``failed(name)`` and the node's reason): the
+    successes on stdout, the failures on stderr. Exit 1 when one failed (ros2 exits 0)."""
+    render(results, args.format, [succeeded(r["name"]) for r in results if r["successful"]])
+    if args.format == "text":
+        print_lines([failed(r["name"]) + (f": {r['reason']}" if r["reason"] else "")
+                     for r in results if not r["successful"]], sys.stderr)
+    return 0 if all(r["successful"] for r in results) else 1
 
 
 def run(args: argparse.Namespace) -> int:
-    """Exit 1 when the node refused a parameter (its reason printed, as ros2 does)."""
     if len(args.assignments) % 2:
         raise UsageError(f"parameter '{args.assignments[-1]}' has no value: give NAME VALUE pairs")
     pairs = list(zip(args.assignments[::2], args.assignments[1::2]))
     results = set_parameters(args, args.node_name, [{"name": name, **parse_value(text)} for name, text in pairs])
-    lines = result_lines(results)
     if len(results) == 1:  # ros2's text for one parameter
-        result = results[0]
-        lines = ["Set parameter successful" if result["successful"] else
-                 "Setting parameter failed" + (f": {result['reason']}" if result["reason"] else "")]
-    render(results, args.format, lines)
-    return 0 if all(r["successful"] for r in results) else 1
+        return report(args, results, lambda _: "Set parameter successful", lambda _: "Setting parameter failed")
+    return report(args, results, lambda name: f"Set parameter {name} successful",
+                  lambda name: f"Set parameter {name} failed")
