@@ -18,6 +18,8 @@ TALKER = {"name": "talker", "publishers": [
     {"topic": "chatter", "type": "std_msgs/msg/String", "values": {"data": "hello"}, "rate_hz": 20},
     {"topic": "latched", "type": "std_msgs/msg/String", "values": {"data": "kept"},
      "durability": "transient_local", "depth": 1},
+    {"topic": "sensor", "type": "std_msgs/msg/String", "values": {"data": "raw"}, "rate_hz": 20,
+     "reliability": "best_effort"},
     {"topic": "stamped", "type": "std_msgs/msg/Header", "values": {"frame_id": "map"}, "rate_hz": 50,
      "stamp_now": True}]}
 MOTOR = {"name": "motor", "services": [{"name": "~/enable", "type": "std_srvs/srv/SetBool"}],
@@ -56,6 +58,15 @@ def test_echo_adapts_to_a_transient_local_publisher_and_prints_json(graph) -> No
     assert line["info"]["publication_sequence_number"] == 1
     filtered = roc("topic", "echo", "/chatter", "--once", "--filter", "m.data == 'hello'", "--csv", env=env)
     assert (filtered.returncode, filtered.stdout) == (0, "hello\n")
+
+
+def test_echo_follows_a_best_effort_publisher_unless_told_otherwise(graph) -> None:
+    env, _ = graph
+    adapted = roc("topic", "echo", "/sensor", "--once", "--qos-profile", "default", env=env)  # default: reliable
+    assert (adapted.returncode, adapted.stdout) == (0, "data: raw\n---\n")
+    forced = roc("topic", "echo", "/sensor", "--once", "--qos-reliability", "reliable", "--timeout", "2", env=env)
+    assert (forced.returncode, forced.stdout) == (1, "")  # a reliable subscription never matches it
+    assert forced.stderr == "roc: error: no message on /sensor within 2 s (--timeout)\n"
 
 
 def test_echo_errors_are_one_line(graph) -> None:
