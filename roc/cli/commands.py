@@ -67,6 +67,8 @@ COMMANDS = (
     (("interface", "package"), (), "interface_package", "list the interfaces of one package"),
     (("interface", "show"), (), "interface_show", "print an interface definition, nested types expanded"),
     (("interface", "proto"), (), "interface_proto", "print a YAML prototype of a message, request or goal"),
+    (("graph",), (), None, "the running ROS system as a whole: check it against declared expectations"),
+    (("graph", "check"), (), "graph_check", "probe the running system against roc.toml's [check] expectations"),
     (("daemon",), (), None, "the roc daemon (a warm graph participant): start, stop, status"),
     (("daemon", "start"), (), "daemon_start", "start the roc daemon of this discovery environment"),
     (("daemon", "stop"), (), "daemon_stop", "stop the roc daemon of this discovery environment"),

@@ -115,6 +115,11 @@ def rewrite_passthrough(argv: list[str], known_options: set[str]) -> list[str]:
 def add_graph_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of every verb that queries the ROS graph."""
     add_format_argument(parser)
+    add_discovery_arguments(parser)
+
+
+def add_discovery_arguments(parser: argparse.ArgumentParser) -> None:
+    """How a graph verb reaches the graph: through the roc daemon, or discovering it itself."""
     parser.add_argument("--no-daemon", action="store_true", help="do not use (or start) the roc daemon")
     parser.add_argument("--spin-time", type=float, metavar="SECONDS",
                         help="without the daemon: how long to discover the graph (default: 3.5, one DDS "
