@@ -82,7 +82,7 @@ def _topic(expectation: Expectation, session, timeout: float, window: float) -> 
                     raise Failed(f"QoS incompatible ({problems[0]['policy']}): {publisher['node_name']} -> "
                                  f"{subscriber['node_name']}: {problems[0]['message']}", measured)
     if "min-rate" in expected or "max-rate" in expected:
-        rate = measure_rate(session, expectation.name, min(window, timeout))
+        rate = measure_rates(session, [expectation.name], min(window, timeout)).get(expectation.name)
         measured["rate"] = rate
         if rate is None:
             raise Failed(f"no messages in {window:g} s, expected at least {expected.get('min-rate', 0):g} Hz", measured)
@@ -94,17 +94,20 @@ def _topic(expectation: Expectation, session, timeout: float, window: float) -> 
     return ", ".join(found), measured
 
 
-def measure_rate(session, topic: str, seconds: float) -> float | None:
-    """The publishers' rate over ``seconds`` (roc.ros.rates), or None without two messages."""
-    window = Window(100_000)
+def measure_rates(session, topics: list[str], seconds: float) -> dict[str, float]:
+    """The publishers' rate of each topic over ``seconds`` (topics with fewer than two messages left out)."""
+    windows = {topic: Window(1_000_000) for topic in topics}
+    if seconds <= 0 or not topics:
+        return {}
     deadline = time.monotonic() + seconds
-    for event in session.stream("stats", {"topics": [topic], "period": min(0.5, seconds)}, heartbeats=True):
+    for event in session.stream("stats", {"topics": topics, "period": min(0.5, seconds)}, heartbeats=True):
         if event["event"] == "batch":
-            window.add(samples(event["topics"][topic]))
+            for topic, columns in event["topics"].items():
+                windows[topic].add(samples(columns))
         if time.monotonic() >= deadline:
             break
-    rate = window.rate()
-    return rate["rate"] if rate else None
+    rates = {topic: window.rate() for topic, window in windows.items()}
+    return {topic: rate["rate"] for topic, rate in rates.items() if rate}
 
 
 def _service(expectation: Expectation, session, timeout: float, _window: float) -> tuple[str, Any]:

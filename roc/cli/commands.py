@@ -69,6 +69,7 @@ COMMANDS = (
     (("interface", "proto"), (), "interface_proto", "print a YAML prototype of a message, request or goal"),
     (("graph",), (), None, "the running ROS system as a whole: check it against declared expectations"),
     (("graph", "check"), (), "graph_check", "probe the running system against roc.toml's [check] expectations"),
+    (("graph", "snapshot"), (), "graph_snapshot", "print the [check] expectations the running system meets now"),
     (("daemon",), (), None, "the roc daemon (a warm graph participant): start, stop, status"),
     (("daemon", "start"), (), "daemon_start", "start the roc daemon of this discovery environment"),
     (("daemon", "stop"), (), "daemon_stop", "stop the roc daemon of this discovery environment"),
