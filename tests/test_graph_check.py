@@ -143,3 +143,53 @@ def test_bad_expectations_name_file_line_and_key(tmp_path: Path, text: str, erro
     with pytest.raises(UsageError) as raised:
         load_checks(tmp_path / "roc.toml")
     assert str(raised.value).startswith(f"{tmp_path}/{error}")
+
+
+def _free_port() -> int:
+    import socket
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def test_watch_serves_prometheus_metrics_until_ctrl_c(graph, tmp_path: Path) -> None:
+    import signal
+    import subprocess
+    import time
+    import urllib.error
+    import urllib.request
+
+    from build_helpers import BIN, stop_process
+    from prometheus_client.parser import text_string_to_metric_families
+
+    check = tmp_path / "expected.toml"
+    check.write_text('[check]\nrate-window = 1\nnodes = ["/talker", "/ghost"]\n'
+                     '[[check.topic]]\nname = "/chatter"\nmin-rate = 15\n')
+    port = _free_port()
+    url = f"http://127.0.0.1:{port}/metrics"
+    watch = subprocess.Popen([str(BIN / "roc"), "graph", "check", "--file", str(check), "--watch", "--interval", "1",
+                              "--prometheus", str(port)], env=graph, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True)
+    try:
+        samples: dict = {}
+        deadline = time.monotonic() + 30
+        while samples.get(("roc_check_rounds", ())) is None or samples[("roc_check_rounds", ())] < 2:
+            assert time.monotonic() < deadline, "no second round of metrics"
+            time.sleep(0.3)
+            try:
+                text = urllib.request.urlopen(url, timeout=2).read().decode()
+            except (urllib.error.URLError, ConnectionError):
+                continue
+            samples = {(s.name, tuple(sorted(s.labels.items()))): s.value
+                       for family in text_string_to_metric_families(text) for s in family.samples}
+        assert samples[("roc_probe_status", (("kind", "node"), ("probe", "node /talker")))] == 1.0
+        assert samples[("roc_probe_status", (("kind", "node"), ("probe", "node /ghost")))] == 0.0
+        assert samples[("roc_topic_rate_hz", (("topic", "/chatter"),))] == pytest.approx(20, rel=0.05)
+        assert samples[("roc_topic_endpoints", (("side", "publishers"), ("topic", "/chatter")))] == 1.0
+        watch.send_signal(signal.SIGINT)
+        assert watch.wait(timeout=15) == 130
+    finally:
+        stop_process(watch)
+    with pytest.raises(urllib.error.URLError):
+        urllib.request.urlopen(url, timeout=2)
