@@ -110,3 +110,5 @@ def stop_daemon(env: dict[str, str]) -> None:
             os.kill(pid, 9)
         except ProcessLookupError:
             pass
+    if (ORACLE_VENV / "bin" / "ros2").exists():  # the oracle may have started its daemon in this domain
+        ros2("daemon", "stop", env=env)
