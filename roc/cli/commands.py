@@ -70,6 +70,8 @@ COMMANDS = (
     (("graph",), (), None, "the running ROS system as a whole: check it against declared expectations"),
     (("graph", "check"), (), "graph_check", "probe the running system against roc.toml's [check] expectations"),
     (("graph", "snapshot"), (), "graph_snapshot", "print the [check] expectations the running system meets now"),
+    (("frame",), (), None, "tf frames and transforms: convert"),
+    (("frame", "convert"), (), "frame_convert", "convert rotations between representations; compose and invert transforms"),
     (("daemon",), (), None, "the roc daemon (a warm graph participant): start, stop, status"),
     (("daemon", "start"), (), "daemon_start", "start the roc daemon of this discovery environment"),
     (("daemon", "stop"), (), "daemon_stop", "stop the roc daemon of this discovery environment"),
