@@ -83,3 +83,54 @@ def test_convert_prints_as_tf2_echo_and_json() -> None:
 def test_convert_errors(args: list[str], error: str) -> None:
     result = _convert(*args)
     assert result.returncode == 2 and result.stderr.startswith(f"roc: error: {error}")
+
+
+def _tree():
+    from roc.frames.buffer import Buffer
+
+    buffer = Buffer()
+    second = 1_000_000_000
+    buffer.add("map", "odom", 0, Transform((1, 0, 0)), static=True)
+    buffer.add("/odom", "base_link", 10 * second, Transform((0, 0, 0)), static=False)
+    buffer.add("odom", "base_link", 12 * second, Transform((2, 0, 0), Transform.from_euler((0, 0, 0), (0, 0, math.pi / 2)).rotation), static=False)
+    buffer.add("base_link", "laser", 0, Transform((0, 1, 0)), static=True)
+    buffer.add("camera", "lens", 0, Transform((0, 0, 1)), static=True)
+    return buffer, second
+
+
+def test_buffer_lookups_equal_transforms_composed_by_hand() -> None:
+    buffer, second = _tree()
+    latest, stamp = buffer.lookup("map", "laser")
+    assert stamp == 12 * second
+    by_hand = Transform((1, 0, 0)) @ buffer.links["base_link"].transforms[-1] @ Transform((0, 1, 0))
+    assert close(latest.matrix(), by_hand.matrix()) and close(latest.translation, (2, 0, 0))
+    inverse, _ = buffer.lookup("laser", "map")
+    assert close(inverse.matrix(), by_hand.inverse().matrix())
+    sibling, _ = buffer.lookup("laser", "odom")  # up to base_link's parent and down again
+    assert close(sibling.matrix(), (buffer.links["base_link"].transforms[-1] @ Transform((0, 1, 0))).inverse().matrix())
+
+
+def test_buffer_interpolates_between_stamps() -> None:
+    buffer, second = _tree()
+    half, stamp = buffer.lookup("odom", "base_link", 11 * second)
+    assert stamp == 11 * second
+    assert close(half.translation, (1, 0, 0)) and half.euler()[2] == pytest.approx(math.pi / 4)
+    static_only, stamp = buffer.lookup("camera", "lens")
+    assert stamp == 0 and close(static_only.translation, (0, 0, 1))
+
+
+@pytest.mark.parametrize("target, source, stamp, error", [
+    ("map", "nowhere", 0, "frame 'nowhere' (source) does not exist (frames: base_link, camera, laser, lens, map, odom)"),
+    ("map", "lens", 0, "map and lens are not connected (trees: camera->lens; map->odom->base_link->laser)"),
+    ("map", "base_link", 13, "lookup would need extrapolation into the future: asked for 13.000, the latest "
+                             "transform of base_link is at 12.000"),
+    ("map", "base_link", 9, "lookup would need extrapolation into the past: asked for 9.000, the oldest "
+                            "transform of base_link kept is at 10.000"),
+])
+def test_buffer_errors(target: str, source: str, stamp: int, error: str) -> None:
+    from roc.frames.buffer import TransformUnavailable
+
+    buffer, second = _tree()
+    with pytest.raises(TransformUnavailable) as raised:
+        buffer.lookup(target, source, stamp * second)
+    assert str(raised.value) == error

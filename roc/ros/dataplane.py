@@ -165,7 +165,7 @@ def publish(graph, params: dict[str, Any], prepare: Callable[[], bytes] | None =
     """Publish ``params["data"]`` (base64 CDR of a ``type`` message) on ``topic``: wait for ``wait``
     matching subscriptions (``{"event": "waiting"}`` each second, at most ``max_wait`` seconds), then
     ``times`` messages (0: until closed) at ``rate`` Hz, ``{"event": "published", "count"}`` after each,
-    keeping the publisher ``keep_alive`` seconds after the last. In-process only: ``prepare`` gives the
+    keeping the publisher ``keep_alive`` seconds after the last (null: until closed). In-process only: ``prepare`` gives the
     CDR to send before each message (stamped with the time)."""
     cls = message_class(params["type"])
     data = base64.b64decode(params["data"])
@@ -197,7 +197,11 @@ def publish(graph, params: dict[str, Any], prepare: Callable[[], bytes] | None =
                 time.sleep(min(remaining, HEARTBEAT_SECONDS))
                 if remaining > HEARTBEAT_SECONDS:
                     yield {"event": "heartbeat"}
-        time.sleep(params.get("keep_alive", 0.1))
+        keep_alive = params.get("keep_alive", 0.1)
+        kept_until = time.monotonic() + keep_alive if keep_alive is not None else float("inf")  # null: until closed
+        while (remaining := kept_until - time.monotonic()) > 0:
+            time.sleep(min(remaining, HEARTBEAT_SECONDS))
+            yield {"event": "heartbeat"}
     finally:
         graph.node.destroy_publisher(publisher)
 
@@ -344,7 +348,40 @@ def _done(future) -> bool:
     return future.done()
 
 
-STREAMS = {"echo": echo, "publish": publish, "stats": stats, "call": call, "goal": goal}
+TF_TYPE = "tf2_msgs/msg/TFMessage"
+
+
+def frames(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+    """Subscribe to /tf (QoS following its publishers, depth 100) and /tf_static (transient local, as
+    tf2's static listener does) and yield ``messages {messages: [{static, data, received}]}`` batches
+    of TFMessage CDR, ``subscribed`` first and heartbeats in between."""
+    cls = message_class(TF_TYPE)
+    arrived: queue.SimpleQueue = queue.SimpleQueue()
+    dynamic = qos_profile({"profile": "default", "depth": 100}, graph.node.get_publishers_info_by_topic("/tf"))
+    static = qos_profile({"profile": "default", "depth": 100, "durability": "transient_local", "reliability": "reliable"})
+    subscriptions = [
+        graph.node.create_subscription(cls, "/tf", lambda data, info: arrived.put((False, data, info)), dynamic, raw=True),
+        graph.node.create_subscription(cls, "/tf_static", lambda data, info: arrived.put((True, data, info)), static,
+                                       raw=True)]
+    try:
+        yield {"event": "subscribed", "type": TF_TYPE}
+        while True:
+            try:
+                batch = [arrived.get(timeout=HEARTBEAT_SECONDS)]
+            except queue.Empty:
+                yield {"event": "heartbeat"}
+                continue
+            while len(batch) < MAX_BATCH and not arrived.empty():
+                batch.append(arrived.get())
+            yield {"event": "messages", "messages": [
+                {"static": is_static, "data": base64.b64encode(data).decode(), "received": info.get("received_timestamp")}
+                for is_static, data, info in batch]}
+    finally:
+        for subscription in subscriptions:
+            graph.node.destroy_subscription(subscription)
+
+
+STREAMS = {"echo": echo, "publish": publish, "stats": stats, "call": call, "goal": goal, "frames": frames}
 
 
 def local_stream(method: str, params: dict[str, Any], node_name: str | None = None,

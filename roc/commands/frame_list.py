@@ -1,0 +1,65 @@
+"""roc frame list: every tf frame with its parent, static or dynamic, rate, the age of its latest
+transform and the nodes publishing tf, after listening --duration seconds."""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+from roc.cli.options import add_discovery_arguments, add_format_argument
+from roc.render import render, table_lines
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--duration", type=float, default=2.0, metavar="SECONDS",
+                        help="how long to listen to /tf and /tf_static first (default: 2)")
+    add_format_argument(parser)
+    add_discovery_arguments(parser)
+
+
+def frame_rows(listener, publishers: dict[str, list[str]]) -> list[dict]:
+    """One dict per frame (roots too, with no parent)."""
+    now = time.time_ns()
+    rows = []
+    for frame in listener.buffer.frames():
+        link = listener.buffer.links.get(frame)
+        if link is None:
+            rows.append({"frame": frame, "parent": None, "static": None, "rate": None, "age": None, "publishers": []})
+            continue
+        age = None if link.static else (now - link.stamps[-1]) * 1e-9
+        rows.append({"frame": frame, "parent": link.parent, "static": link.static,
+                     "rate": None if link.static else link.rate(), "age": age,
+                     "publishers": publishers["/tf_static" if link.static else "/tf"]})
+    return rows
+
+
+def tf_publishers(use_daemon: bool) -> dict[str, list[str]]:
+    """The nodes publishing /tf and /tf_static (tf messages do not say which node sent a frame)."""
+    from roc.errors import RocError
+    from roc.ros.client import query
+
+    found = {}
+    for topic in ("/tf", "/tf_static"):
+        try:
+            info = query("topic_endpoints", {"topic": topic}, use_daemon=use_daemon, spin_time=1.0)
+            found[topic] = sorted({f"{p['node_namespace'].rstrip('/')}/{p['node_name']}" for p in info["publishers"]})
+        except RocError:
+            found[topic] = []
+    return found
+
+
+def run(args: argparse.Namespace) -> int:
+    from roc.frames.listen import Listener
+
+    listener = Listener(use_daemon=not args.no_daemon)
+    try:
+        listener.listen(seconds=args.duration)
+    finally:
+        listener.close()
+    rows = frame_rows(listener, tf_publishers(not args.no_daemon))
+    text = table_lines([[r["frame"], r["parent"] or "-", "-" if r["static"] is None else "static" if r["static"] else "dynamic",
+                         f"{r['rate']:.1f} Hz" if r["rate"] else "-", f"{r['age']:.3f} s" if r["age"] is not None else "-",
+                         ", ".join(r["publishers"]) or "-"] for r in rows],
+                       header=["frame", "parent", "kind", "rate", "age", "publishers"]) if rows else ["no tf frames heard"]
+    render(rows, args.format, text)
+    return 0

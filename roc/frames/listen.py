@@ -1,0 +1,61 @@
+"""A tf buffer filled from /tf and /tf_static (roc.ros.dataplane's ``frames`` stream, in the daemon
+when it runs), for the frame verbs."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+from roc.errors import UsageError
+from roc.frames.buffer import Buffer
+from roc.frames.transform import Transform
+from roc.ros.client import stream
+from roc.ros.types import UnknownTypeError, message_class
+
+TF_TYPE = "tf2_msgs/msg/TFMessage"
+
+
+def require_tf2_msgs() -> None:
+    """One line saying what to do when tf2_msgs is not installed (the ROS wheels of PyPI lack it)."""
+    try:
+        message_class(TF_TYPE)
+    except UnknownTypeError:
+        raise UsageError("tf2_msgs is not installed (the ROS 2 wheels from PyPI lack it): source a ROS "
+                         "install that has it, or build the tf2_msgs package of roc's "
+                         "workspaces/fixtures/tf with 'roc work build' and source its install/setup.bash") from None
+
+
+class Listener:
+    """The buffer and the delays seen (reception minus stamp, per child frame)."""
+
+    def __init__(self, use_daemon: bool = True):
+        require_tf2_msgs()
+        self.buffer = Buffer()
+        self.delays: dict[str, list[float]] = {}
+        self._events = stream("frames", {}, use_daemon=use_daemon, heartbeats=True)
+
+    def listen(self, done: Callable[[], bool] = lambda: False, seconds: float | None = None) -> bool:
+        """Take in transforms until ``done()`` (True) or ``seconds`` have passed (False)."""
+        from roc.ros.dataplane import decode
+
+        deadline = time.monotonic() + seconds if seconds is not None else None
+        if done():
+            return True
+        for event in self._events:
+            for message in event.get("messages", ()):
+                for stamped in decode(TF_TYPE, message["data"]).transforms:
+                    stamp = stamped.header.stamp.sec * 1_000_000_000 + stamped.header.stamp.nanosec
+                    t, r = stamped.transform.translation, stamped.transform.rotation
+                    received = message["received"] or time.time_ns()
+                    self.buffer.add(stamped.header.frame_id, stamped.child_frame_id, stamp,
+                                    Transform((t.x, t.y, t.z), (r.x, r.y, r.z, r.w)), message["static"], received)
+                    if not message["static"]:
+                        self.delays.setdefault(stamped.child_frame_id.lstrip("/"), []).append((received - stamp) * 1e-9)
+            if done():
+                return True
+            if deadline is not None and time.monotonic() >= deadline:
+                return False
+        return False
+
+    def close(self) -> None:
+        self._events.close()

@@ -1,0 +1,123 @@
+"""roc frame verbs on a live tf tree: tf2_msgs built by roc from workspaces/fixtures/tf, sourced, and a
+tree published by real rclpy nodes (tests/tf_node.py): map->odom (static), odom->base_link (20 Hz,
+yaw 90 degrees), base_link->laser (static), and a second tree camera->lens."""
+
+from __future__ import annotations
+
+import json
+import contextlib
+import os
+import queue
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+from build_helpers import BIN, copy_fixture, roc, stop_process
+from graph_helpers import graph_env, stop_daemon
+
+pytestmark = pytest.mark.slow
+TF_NODE = Path(__file__).resolve().parent / "tf_node.py"
+
+
+@pytest.fixture(scope="module")
+def sourced(tmp_path_factory):
+    """A graph environment with the built tf2_msgs sourced."""
+    workspace = copy_fixture("tf", tmp_path_factory.mktemp("tf") / "ws")
+    built = roc("work", "build", cwd=workspace)
+    assert built.returncode == 0, built.stdout + built.stderr
+    env = graph_env(65, tmp_path_factory.mktemp("runtime"))
+    dumped = subprocess.run(["bash", "-c", f'source "{workspace}/install/setup.bash" && env -0'], env=env,
+                            capture_output=True, timeout=60)
+    assert dumped.returncode == 0, dumped.stderr
+    env = dict(item.split("=", 1) for item in dumped.stdout.decode().split("\0") if "=" in item)
+    yield env
+    stop_daemon(env)
+
+
+@pytest.fixture(scope="module")
+def tree(sourced):
+    process = subprocess.Popen([sys.executable, str(TF_NODE), "publish"], env=sourced, stdout=subprocess.PIPE,
+                               stderr=subprocess.DEVNULL, text=True)
+    assert process.stdout.readline().strip() == "ready"
+    yield sourced
+    stop_process(process)
+
+
+def frame(*args: str, env: dict[str, str]) -> subprocess.CompletedProcess:
+    return subprocess.run([str(BIN / "roc"), "frame", *args], env=env, capture_output=True, text=True, timeout=60)
+
+
+def test_echo_composes_the_chain(tree) -> None:
+    result = frame("echo", "map", "laser", "--once", env=tree)
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert lines[0].startswith("At time ")
+    # map->odom (1, 0, 0), then odom->base_link turned 90 degrees, then base_link->laser (0, 1, 0): (0, 0, 0)
+    assert lines[1:5] == ["- Translation: [0.000, 0.000, 0.000]",
+                          "- Rotation: in Quaternion (xyzw) [0.000, 0.000, 0.707, 0.707]",
+                          "- Rotation: in RPY (radian) [0.000, 0.000, 1.571]",
+                          "- Rotation: in RPY (degree) [0.000, 0.000, 90.000]"]
+    as_json = json.loads(frame("echo", "laser", "map", "--once", "--format", "json", "--no-daemon", env=tree).stdout)
+    assert as_json["translation"] == pytest.approx([0, 0, 0], abs=1e-9)
+    assert as_json["rpy_degrees"][2] == pytest.approx(-90)
+
+
+def test_unconnected_frames_are_one_error(tree) -> None:
+    result = frame("echo", "map", "lens", "--timeout", "2", env=tree)
+    assert result.returncode == 1
+    assert result.stderr == ("roc: error: no transform from map to lens within 2 s: map and lens are not connected "
+                             "(trees: camera->lens; map->odom->base_link->laser)\n")
+
+
+def test_list_and_tree(tree, tmp_path: Path) -> None:
+    rows = {r["frame"]: r for r in json.loads(frame("list", "--format", "json", "--duration", "1.5", env=tree).stdout)}
+    assert sorted(rows) == ["base_link", "camera", "laser", "lens", "map", "odom"]
+    assert (rows["odom"]["parent"], rows["odom"]["static"]) == ("map", True)
+    assert rows["base_link"]["static"] is False and rows["base_link"]["rate"] == pytest.approx(20, rel=0.15)
+    assert rows["base_link"]["publishers"] == ["/tf_publish"] and rows["map"]["parent"] is None
+    text = frame("tree", "--duration", "1", env=tree).stdout.splitlines()
+    assert [line.split(" [")[0] for line in text] == ["camera", "└── lens", "map", "└── odom", "    └── base_link",
+                                                      "        └── laser"]
+    dot = tmp_path / "tf.dot"
+    assert frame("tree", "--duration", "1", "--output", str(dot), env=tree).returncode == 0
+    assert '"odom" -> "base_link" [label="' in dot.read_text() and dot.read_text().startswith("digraph tf {")
+    png = tmp_path / "tf.png"
+    drawn = frame("tree", "--duration", "1", "--output", str(png), env=tree)
+    if drawn.returncode == 0:
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    else:
+        assert "Graphviz's 'dot' program is not installed" in drawn.stderr and not png.exists()
+
+
+def test_pub_reaches_a_real_subscriber_and_ctrl_c_stops_it(sourced) -> None:
+    listener = subprocess.Popen([sys.executable, str(TF_NODE), "listen"], env=sourced, stdout=subprocess.PIPE,
+                                stderr=subprocess.DEVNULL, text=True)
+    pub = subprocess.Popen([str(BIN / "roc"), "frame", "pub", "world", "robot", "--x", "2.5"], env=sourced,
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert listener.stdout.readline().strip() == "ready"
+        assert pub.stdout.readline().startswith("publishing world -> robot on /tf_static")
+        lines: queue.SimpleQueue = queue.SimpleQueue()
+        threading.Thread(target=lambda: [lines.put(line) for line in listener.stdout], daemon=True).start()
+        heard, deadline = [], time.monotonic() + 15  # (the tree's transforms too, while it is published)
+        while {"parent": "world", "child": "robot", "x": 2.5} not in heard and time.monotonic() < deadline:
+            with contextlib.suppress(queue.Empty):
+                heard.append(json.loads(lines.get(timeout=0.5)))
+        assert {"parent": "world", "child": "robot", "x": 2.5} in heard
+        pub.send_signal(signal.SIGINT)
+        assert pub.wait(timeout=10) == 130
+    finally:
+        stop_process(pub)
+        stop_process(listener)
+
+
+def test_without_tf2_msgs_every_frame_verb_says_what_to_do(tmp_path: Path) -> None:
+    env = graph_env(65, tmp_path)
+    env = {k: v for k, v in env.items() if k != "PYTHONPATH"} | {"AMENT_PREFIX_PATH": os.environ.get("VIRTUAL_ENV", sys.prefix)}
+    for verb in (["list"], ["echo", "a", "b"], ["tree"], ["monitor"], ["pub", "a", "b"]):
+        result = frame(*verb, env=env)
+        assert result.returncode == 2 and result.stderr.startswith("roc: error: tf2_msgs is not installed"), verb
