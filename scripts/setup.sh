@@ -98,6 +98,12 @@ say "installing roc (editable, with the test extra) and the ROS 2 Jazzy wheels"
 pip_q install -q --config-settings editable_mode=compat -e "$ROOT[test]" -r "$ROOT/requirements/ros-jazzy.txt" \
     || pip_q install -q -e "$ROOT[test]" -r "$ROOT/requirements/ros-jazzy.txt"
 
+# ---- the colcon oracle's setuptools -------------------------------------------------------
+# colcon reads a setup.py through the setuptools it runs with, and setuptools 72+ (which grpcio-tools
+# needs) drops tests_require. The tests run colcon's package identification with Jazzy's platform
+# setuptools (Ubuntu 24.04: 68.1.2), kept apart from the venv's (tests/fixture_workspaces.py).
+pip_q install -q --upgrade --target "$VENV/oracle-setuptools" "setuptools==68.1.2"
+
 # ---- fix-ups of the wheels' CMake files ---------------------------------------------------
 "$VPY" "$ROOT/scripts/fix_ros_wheels.py"
 

@@ -20,6 +20,7 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 FIXTURES = REPO / "workspaces" / "fixtures"
+ORACLE_SETUPTOOLS = Path(sys.prefix) / "oracle-setuptools"  # installed by scripts/setup.sh
 GOOD_FIXTURES = ("discovery", "formats", "cmake", "python", "colcon_pkg", "selection")
 # colcon reads conditions from the environment only; roc defaults ROS_VERSION and ROS_PYTHON_VERSION
 # (a deliberate difference), so both run with them set.
@@ -111,7 +112,9 @@ sys.__stdout__.write(json.dumps(results))
 
 
 def run_colcon_batch(commands: list[list[str]], cwd: Path, env: dict[str, str]) -> list[Result]:
-    """The exit code and stdout of ``colcon <command>`` for each command, run in ``cwd``."""
+    """The exit code and stdout of ``colcon <command>`` for each command, run in ``cwd``, with the
+    setuptools of Jazzy's platform (72+ drops ``tests_require``, which colcon then does not report)."""
+    env = {**env, "PYTHONPATH": os.pathsep.join(filter(None, [str(ORACLE_SETUPTOOLS), env.get("PYTHONPATH")]))}
     process = subprocess.run(
         [sys.executable, "-c", _COLCON_BATCH, json.dumps(commands)], cwd=cwd, env=env,
         capture_output=True, text=True, timeout=300,

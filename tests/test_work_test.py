@@ -36,6 +36,13 @@ def _commands_by_package(stdout: str) -> set[str]:
     return {e["task"] for e in events if e["event"] == "CommandStarted"}
 
 
+def _reasons(stdout: str) -> dict[str, list[str]]:
+    """Why each test task ran (``--output json``); test tasks are of kind ``test``."""
+    events = [json.loads(line) for line in stdout.splitlines() if line.startswith("{")]
+    assert {e["kind"] for e in events if e["task"]} <= {"test"}
+    return {e["task"]: e["reasons"] for e in events if e["event"] == "TaskStarted"}
+
+
 def test_results_equal_colcon_and_are_cached(tmp_path: Path) -> None:
     workspace = copy_fixture("testing", tmp_path / "ws")
     built = roc("work", "build", cwd=workspace)
@@ -55,13 +62,20 @@ def test_results_equal_colcon_and_are_cached(tmp_path: Path) -> None:
     assert _results(colcon, workspace) == colcon_results
     assert _results(roc, workspace) == colcon_results
     assert _rc_files(workspace) == colcon_rc
-    assert sorted(p.name for p in (workspace / "log" / "latest_test").iterdir()) == [
-        "events.log", "t_cmake_pytest", "t_gtest", "t_plain", "t_py"]
+    latest = workspace / "log" / "latest_test"
+    assert sorted(p.name for p in latest.iterdir()) == ["events.log", "t_cmake_pytest", "t_gtest", "t_plain", "t_py"]
+    assert (latest / "t_gtest" / "stdout_stderr.log").is_file() and not (latest / "t_gtest" / "test").exists()
+    events = [json.loads(line) for line in (latest / "events.log").read_text().splitlines()]
+    assert {e["kind"] for e in events if e["task"]} == {"test"}
+    assert {e["task"] for e in events if e["event"] == "TestFailures"} == FAILING
+    assert {e["task"]: e["reasons"] for e in events if e["event"] == "TaskStarted"} == {
+        name: ["--force"] for name in FAILING | {"t_gtest", "t_notests"}}
 
     # Passing packages are cached, failing ones run again.
     second = roc("work", "test", "--output", "json", cwd=workspace)
     assert second.returncode == 0
     assert _commands_by_package(second.stdout) == FAILING
+    assert _reasons(second.stdout) == {name: ["failed last time"] for name in FAILING}
     assert _results(roc, workspace) == colcon_results
     # Only passing packages: no test process at all.
     passing = roc("work", "test", "t_gtest", "t_notests", "--output", "json", cwd=workspace)
@@ -73,6 +87,7 @@ def test_results_equal_colcon_and_are_cached(tmp_path: Path) -> None:
     test_source.write_text(test_source.read_text() + "// edited\n")
     edited = roc("work", "test", "--output", "json", cwd=workspace)
     assert _commands_by_package(edited.stdout) == FAILING | {"t_gtest"}
+    assert _reasons(edited.stdout)["t_gtest"] == ["files changed: test/test_math.cpp"]
     forced = roc("work", "test", "--force", "--output", "json", cwd=workspace)
     assert _commands_by_package(forced.stdout) == FAILING | {"t_gtest"}  # t_notests has no CTest tests
 

@@ -4,10 +4,31 @@ the last test result."""
 from __future__ import annotations
 
 import argparse
+import io
 from pathlib import Path
 
 from roc.cli.options import add_selection_arguments
-from roc.testing.cache import passed_before, read_test_state, results_key, write_test_state
+from roc.engine.events import (
+    RunFinished,
+    TaskAborted,
+    TaskFailed,
+    TaskFinished,
+    TaskOutput,
+    TaskQueued,
+    TaskSkipped,
+    TaskStarted,
+    TestFailures,
+)
+from roc.handlers.console import ConsoleHandler
+from roc.handlers.logs import ResultStore
+from roc.testing.cache import (
+    read_test_state,
+    rerun_reasons,
+    results_key,
+    results_parts,
+    write_test_state,
+)
+from roc.testing.plan import PackageTest
 from roc.testing.runner import TestOptions, pytest_addopts
 from roc.workspace.package import Package
 from roc.workspace.selection import select_packages
@@ -35,22 +56,60 @@ def test_cached_result_needs_the_same_key_a_pass_and_the_result_files(tmp_path: 
     (source / "test_it.py").write_text("def test_ok(): pass\n")
     (build / "pkg").mkdir(parents=True)
     assert results_key(source, build, "pkg", [], {}, {})[0] is None  # not built by roc: never cached
+    assert rerun_reasons({}, results_parts(source, build, "pkg", [], {}, {})[0]) == ["not built by roc"]
     (build / "pkg" / "roc_state.json").write_text('{"fingerprint": "f1", "files": {}}')
-    key, files = results_key(source, build, "pkg", [], {}, {})
+    (build / "dep").mkdir()
+    (build / "dep" / "roc_state.json").write_text('{"fingerprint": "d1", "files": {}}')
+
+    def reasons(options: dict | None = None) -> list[str]:
+        state = read_test_state(build / "pkg")
+        return rerun_reasons(state, results_parts(source, build, "pkg", ["dep"], options or {}, state)[0])
+
+    assert reasons() == ["never tested"]
+    parts, files = results_parts(source, build, "pkg", ["dep"], {}, {})
+    key, _ = results_key(source, build, "pkg", ["dep"], {}, {})
+    write_test_state(build / "pkg", key, False, files, [], parts)
+    assert reasons() == ["failed last time"]
     result = build / "pkg" / "pytest.xml"
     result.write_text("<testsuite tests='1' failures='0'/>")
-    write_test_state(build / "pkg", key, True, files, [str(result)])
-    state = read_test_state(build / "pkg")
-    assert passed_before(state, key)
-    assert not passed_before(state, results_key(source, build, "pkg", [], {"pytest": ["-x"]}, state)[0])
+    write_test_state(build / "pkg", key, True, files, [str(result)], parts)
+    assert reasons() == []
+    assert reasons({"pytest": ["-x"]}) == ["option changed: pytest"]
     (source / "test_it.py").write_text("def test_ok(): assert True\n")
-    assert not passed_before(state, results_key(source, build, "pkg", [], {}, state)[0])
+    (source / "test_new.py").write_text("")
+    assert reasons() == ["files added: test_new.py", "files changed: test_it.py"]
+    (source / "test_new.py").unlink()
     (source / "test_it.py").write_text("def test_ok(): pass\n")
-    assert passed_before(state, results_key(source, build, "pkg", [], {}, state)[0])
+    assert reasons() == []
+    (build / "pkg" / "roc_state.json").write_text('{"fingerprint": "f2", "files": {}}')
+    assert reasons() == ["build changed"]
+    (build / "pkg" / "roc_state.json").write_text('{"fingerprint": "f1", "files": {}}')
+    (build / "dep" / "roc_state.json").write_text('{"fingerprint": "d2", "files": {}}')
+    assert reasons() == ["dependency changed: dep"]
+    (build / "dep" / "roc_state.json").write_text('{"fingerprint": "d1", "files": {}}')
     result.unlink()
-    assert not passed_before(state, key)
-    write_test_state(build / "pkg", key, False, files, [])
-    assert not passed_before(read_test_state(build / "pkg"), key)
+    assert reasons() == ["result files missing"]
+
+
+def test_the_check_runs_at_dispatch_and_says_why(tmp_path: Path) -> None:
+    """A test task's check reads the state when it is called (not when the task is planned)."""
+    source, build = tmp_path / "src" / "pkg", tmp_path / "build"
+    source.mkdir(parents=True)
+    (source / "test_it.py").write_text("def test_ok(): pass\n")
+    (build / "pkg").mkdir(parents=True)
+    package = Package(name="pkg", path=Path("src", "pkg"), type="ros.ament_python", dependencies={})
+    options = TestOptions(build_base=build, install_base=tmp_path / "install")
+    test = PackageTest(package, source, [], options)
+    assert test.check() == ["not built by roc"]
+    (build / "pkg" / "roc_state.json").write_text('{"fingerprint": "f1", "files": {}}')  # built since
+    assert test.check() == ["never tested"]
+    write_test_state(build / "pkg", "some key", True, test.files, [], test.parts)
+    assert test.check() == ["test inputs changed"]
+    write_test_state(build / "pkg", results_key(source, build, "pkg", [], options.digest(), {})[0], True,
+                     test.files, [], test.parts)
+    assert test.check() == []
+    assert PackageTest(package, source, [], options, force=True).check() == ["--force"]
+    assert PackageTest(package, source, [], options, use_cache=False).check() == ["--no-cache"]
 
 
 def test_selection_by_the_last_test_result(tmp_path: Path) -> None:
@@ -65,3 +124,69 @@ def test_selection_by_the_last_test_result(tmp_path: Path) -> None:
     assert select_packages(failures, packages, tmp_path) == {"failed"}
     not_passed = parser.parse_args(["--packages-skip-test-passed"])
     assert select_packages(not_passed, packages, tmp_path) == {"failed", "aborted", "untested"}
+
+
+def test_console_names_the_runs_own_kind_as_colcon_and_other_kinds_by_key() -> None:
+    """``roc work test`` prints ``Starting >>> pkg`` for its test tasks (as colcon test does); a task of
+    another kind in the same run is named by its key."""
+    stream = io.StringIO()
+    console = ConsoleHandler(stream, kind="test", cached_label="cached",
+                             finished_note=lambda key: "\t[ with test failures ]" if key == "test:b" else "")
+    for event in (TaskQueued("a", "test"), TaskQueued("b", "test"), TaskQueued("c", "test"), TaskQueued("d", "test"),
+                  TaskQueued("x"), TaskStarted("x"), TaskFinished("x", duration=1.0),
+                  TaskFinished("a", "test", cached=True),
+                  TaskStarted("b", "test"), TaskOutput("b", "test", stream="stderr", data=b"oops\n"),
+                  TestFailures("b", "test"),
+                  TaskFinished("b", "test", duration=1.0), TaskStarted("c", "test"),
+                  TaskFailed("c", "test", duration=1.0, reason="ctest exited with code 2"),
+                  TaskSkipped("d", "test", because_of="test:c"), RunFinished("")):
+        console(event)
+    lines = stream.getvalue().splitlines()
+    assert lines[:9] == ["Starting >>> x", "Finished <<< x [1.00s]",
+                         "Starting >>> b", "--- stderr: b", "oops", "---",
+                         "Finished <<< b [1.00s]\t[ with test failures ]", "Starting >>> c",
+                         "Failed   <<< c [1.00s, ctest exited with code 2]"]
+    assert lines[11:] == ["  1 package cached: a", "  1 package failed: c",
+                          "  1 package skipped because a dependency failed: d (needs c)",
+                          "  1 package had stderr output: b", "  1 package had test failures: b"]
+
+    build = io.StringIO()
+    console = ConsoleHandler(build, kind="build")
+    for event in (TaskQueued("a", "idl"), TaskStarted("a", "idl"), TaskFinished("a", "idl", duration=1.0),
+                  TaskStarted("a"), TaskFinished("a", duration=1.0)):
+        console(event)
+    assert build.getvalue().splitlines() == ["Starting >>> idl:a", "Finished <<< idl:a [1.00s]",
+                                             "Starting >>> a", "Finished <<< a [1.00s]"]
+
+
+def test_status_line_names_the_runs_own_kind_by_package() -> None:
+    from rich.console import Console
+
+    from roc.handlers.status import StatusLine
+
+    class Live:
+        def __init__(self) -> None:
+            self.updates: list[str] = []
+
+        def start(self) -> None: ...
+
+        def update(self, renderable, refresh: bool = False) -> None:
+            self.updates.append(str(renderable))
+
+    live = Live()
+    status = StatusLine(console=Console(file=io.StringIO(), width=120), live=live, clock=lambda: 0.0, kind="test")
+    status.MIN_INTERVAL = -1.0
+    for event in (TaskQueued("a", "test"), TaskQueued("a", "idl"), TaskStarted("a", "test"), TaskStarted("a", "idl")):
+        status(event)
+    assert live.updates[-1] == "[0s] [0/2 done] [2 running] a idl:a"
+
+
+def test_result_store_writes_colcons_test_results(tmp_path: Path) -> None:
+    store = ResultStore(tmp_path)
+    for event in (TaskFinished("passed", "test"), TestFailures("failing", "test"), TaskFinished("failing", "test"),
+                  TaskFailed("error", "test"), TaskAborted("stopped", "test"), TaskFinished("built"),
+                  TaskFinished("generated", "idl")):
+        store(event)
+    assert {p.relative_to(tmp_path).as_posix(): p.read_text() for p in tmp_path.glob("*/*")} == {
+        "passed/colcon_test.rc": "0\n", "failing/colcon_test.rc": "test failures\n",
+        "error/colcon_test.rc": "1\n", "stopped/colcon_test.rc": "SIGINT\n", "built/colcon_build.rc": "0\n"}

@@ -4,18 +4,19 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 from pathlib import Path
 
-from roc.cli.options import AppendToCommandLine, add_base_arguments, add_selection_arguments
-from roc.engine.events import Event, RunFinished, TaskAborted, TaskFailed, TaskFinished
+from roc.cli.options import (
+    AppendToCommandLine,
+    add_base_arguments,
+    add_selection_arguments,
+)
+from roc.engine.events import Event, TestFailures
 from roc.errors import EXIT_FAILURE, EXIT_INTERRUPTED, UsageError
-from roc.fsutil import write_text_atomic
-from roc.render import print_lines
-from roc.workspace.selection import INTERRUPTED_RESULT
+from roc.handlers import add_event_handlers_argument, handler_switches, output_handlers
 
 DURATIONS_FILE = "roc_test_durations.json"
-TEST_FAILURE_RESULT = "test failures"
+CACHED_LABEL = "cached (passed before, not tested again)"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -41,40 +42,22 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="test packages in parallel (default) or one at a time")
     add("--parallel-workers", type=int, metavar="NUMBER", default=os.cpu_count() or 1,
         help="packages tested at once, 0 for no limit (default: the number of CPUs)")
-    add("--event-handlers", nargs="*", metavar="NAME+/-", default=[],
-        help="enable (+) or disable (-) output: console_start_end, console_stderr, console_direct, "
-             "console_cohesion, summary, status, log, event_log, store_result")
+    add_event_handlers_argument(parser)
     add("--output", choices=("text", "json"), default="text", help="json: one JSON event per line on stdout")
     add("--force", action="store_true", help="test the selected packages even when their results are cached")
     add("--no-cache", action="store_true", help="neither reuse passing results nor record them")
     add_selection_arguments(parser, previous_test=True)
 
 
-class TestResults:
-    """Each package's result in ``<build-base>/<pkg>/colcon_test.rc`` (as colcon writes it), and the
-    packages with test failures (named in the summary)."""
+class TestFailureKeys:
+    """Which tasks' tests failed (for ``[ with test failures ]`` and the exit code)."""
 
-    __test__ = False
-
-    def __init__(self, build_base: Path, store: bool, summary: bool):
-        self.build_base, self.store, self.summary = build_base, store, summary
-        self.failures: set[str] = set()
+    def __init__(self) -> None:
+        self.keys: set[str] = set()
 
     def __call__(self, event: Event) -> None:
-        from roc.testing.runner import TestFailures
-
         if isinstance(event, TestFailures):
-            self.failures.add(event.task)
-        results = {TaskFinished: "0", TaskFailed: "1", TaskAborted: INTERRUPTED_RESULT}
-        result = results.get(type(event))
-        if result is not None and self.store:
-            if result == "0" and event.task in self.failures:
-                result = TEST_FAILURE_RESULT
-            write_text_atomic(self.build_base / event.task / "colcon_test.rc", result + "\n")
-        if isinstance(event, RunFinished) and self.summary and self.failures:
-            count = len(self.failures)
-            print_lines([f"  {count} package{'' if count == 1 else 's'} had test failures: "
-                         f"{' '.join(sorted(self.failures))}"])
+            self.keys.add(event.key)
 
 
 def _options(args: argparse.Namespace, root: Path):
@@ -100,38 +83,10 @@ def _skip_untestable(workspace) -> None:
             workspace.selected.discard(package.name)
 
 
-def _handlers(args, switches: dict[str, bool], root: Path, results: TestResults) -> list:
-    from roc.handlers.console import ConsoleHandler
-    from roc.handlers.logs import JsonEventsHandler, LogHandler, new_log_directory
-
-    handlers: list = []
-    log_dir = None
-    if args.log_base != os.devnull and switches.get("log", True):
-        log_dir = new_log_directory((root / args.log_base).absolute(), "test")
-        handlers.append(LogHandler(log_dir, events=switches.get("event_log", True)))
-    if args.output == "json":
-        handlers.append(JsonEventsHandler(sys.stdout))
-    else:
-        status = None
-        if switches.get("status", True) and sys.stdout.isatty() and not os.environ.get("NO_COLOR"):
-            from roc.handlers.status import StatusLine
-
-            status = StatusLine()
-        handlers.append(ConsoleHandler(
-            start_end=switches.get("console_start_end", True), stderr=switches.get("console_stderr", True),
-            summary=switches.get("summary", True), direct=switches.get("console_direct", False),
-            cohesion=switches.get("console_cohesion", False), log_path=str(log_dir) if log_dir else None,
-            status=status, cached_label="cached (passed before, not tested again)",
-            finished_note=lambda name: "\t[ with test failures ]" if name in results.failures else "",
-        ))
-    return handlers
-
-
 def run(args: argparse.Namespace) -> int:
     from roc.builder.layout import prepare_build_base, prepare_install_base
     from roc.builder.lock import build_lock
     from roc.commands.work_build import skip_configured_packages
-    from roc.handlers import handler_switches
     from roc.engine.executor import execute
     from roc.engine.store import DurationStore
     from roc.testing.plan import plan_tests
@@ -153,9 +108,11 @@ def run(args: argparse.Namespace) -> int:
         prepare_build_base(options.build_base)
         prepare_install_base(options.install_base, args.merge_install)
         durations = DurationStore(options.build_base / DURATIONS_FILE)
-        results = TestResults(options.build_base, store=switches.get("store_result", True),
-                              summary=args.output == "text" and switches.get("summary", True))
-        handlers = [*_handlers(args, switches, workspace.root, results), results, durations]
+        failures = TestFailureKeys()
+        handlers = [*output_handlers(args, switches, workspace.root, options.build_base, verb="test",
+                                     cached_label=CACHED_LABEL, finished_note=lambda key: (
+                                         "\t[ with test failures ]" if key in failures.keys else "")),
+                    failures, durations]
         try:
             tasks = plan_tests(workspace, options, durations.durations, force=args.force, use_cache=not args.no_cache)
             result = execute(tasks, handlers, workers, continue_on_error=not args.abort_on_error)
@@ -167,4 +124,4 @@ def run(args: argparse.Namespace) -> int:
         return EXIT_INTERRUPTED
     if not result.ok:
         return EXIT_FAILURE
-    return EXIT_FAILURE if args.return_code_on_test_failure and results.failures else 0
+    return EXIT_FAILURE if args.return_code_on_test_failure and failures.keys else 0

@@ -81,6 +81,14 @@ class TaskSkipped(Event):
 
 
 @dataclass(frozen=True)
+class TestFailures(Event):
+    """A test task's tests ran and some failed; the task itself still finishes, as in colcon (its
+    result is "test failures", not a failure of the run)."""
+
+    __test__ = False
+
+
+@dataclass(frozen=True)
 class RunFinished(Event):
     """The whole run ended; ``task`` is empty."""
 

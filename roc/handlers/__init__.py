@@ -81,7 +81,7 @@ def output_handlers(args: argparse.Namespace, switches: dict[str, bool], root: P
     if switches["status"] and sys.stdout.isatty() and not os.environ.get("NO_COLOR"):
         from roc.handlers.status import StatusLine
 
-        status = StatusLine()
+        status = StatusLine(kind=verb)
     handlers.append(ConsoleHandler(
         start_end=switches["console_start_end"], stderr=switches["console_stderr"], summary=switches["summary"],
         direct=switches["console_direct"], cohesion=switches["console_cohesion"],

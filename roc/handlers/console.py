@@ -13,8 +13,10 @@ from roc.engine.events import (
     TaskFailed,
     TaskFinished,
     TaskOutput,
+    TaskQueued,
     TaskSkipped,
     TaskStarted,
+    TestFailures,
 )
 from roc.handlers.logs import task_log_folder
 
@@ -36,7 +38,8 @@ class ConsoleHandler:
     """Prints as colcon's console_start_end, console_stderr and summary handlers do.
 
     ``direct`` echoes all output as it comes (console_direct+); ``cohesion`` prints each package's whole
-    output when it ends (console_cohesion+).
+    output when it ends (console_cohesion+). Tasks of the run's own ``kind`` are named as colcon names
+    them (the package: ``Starting >>> pkg``), other tasks by their key (``idl:pkg``).
     """
 
     def __init__(self, stream: TextIO = sys.stdout, *, start_end: bool = True, stderr: bool = True,
@@ -45,7 +48,7 @@ class ConsoleHandler:
                  finished_note=None):
         self.stream = stream
         self.cached_label = cached_label  # how the summary names tasks that finished without running
-        self.finished_note = finished_note  # (task) -> text appended to its "Finished" line
+        self.finished_note = finished_note  # (task key) -> text appended to its "Finished" line
         self.status = status  # a StatusLine on a terminal: lines are printed above it
         self.start_end, self.stderr, self.summary = start_end, stderr, summary
         self.direct, self.cohesion = direct, cohesion
@@ -59,6 +62,12 @@ class ConsoleHandler:
         self.failed: list[str] = []
         self.aborted: list[str] = []
         self.skipped: dict[str, str] = {}
+        self.test_failures: list[str] = []
+        self._labels: dict[str, str] = {}  # task key -> the name printed
+
+    def label(self, event: Event) -> str:
+        """How a task is named on the console: its name for the run's own kind, else its key."""
+        return event.task if event.kind == self.kind else event.key
 
     def close(self) -> None:
         """Give the terminal back (the live status line) if the run ended without RunFinished."""
@@ -82,13 +91,17 @@ class ConsoleHandler:
             if event.stream == "stderr":
                 self._stderr.setdefault(event.key, bytearray()).extend(event.data)
             self._all.setdefault(event.key, bytearray()).extend(event.data)
+        elif isinstance(event, TaskQueued):
+            self._labels[event.key] = self.label(event)
         elif isinstance(event, TaskStarted):
             if self.start_end:
-                self._print(f"Starting >>> {event.key}")
+                self._print(f"Starting >>> {self.label(event)}")
         elif isinstance(event, (TaskFinished, TaskFailed, TaskAborted)):
             self._ended(event)
         elif isinstance(event, TaskSkipped):
-            self.skipped[event.key] = event.because_of
+            self.skipped[self.label(event)] = self._labels.get(event.because_of, event.because_of)
+        elif isinstance(event, TestFailures):
+            self.test_failures.append(self.label(event))
         elif isinstance(event, RunFinished):
             if self.status is not None:
                 self.status(event)  # stops the live line, before the summary
@@ -99,17 +112,17 @@ class ConsoleHandler:
             self.status(event)
 
     def _ended(self, event: Event) -> None:
-        name = event.key  # a package name for builds (as colcon prints it), kind:name for other tasks
-        if self.cohesion and name in self._all:
-            self._print(f"--- output: {name}\n{self._all[name].decode(errors='replace').rstrip()}\n---")
-        elif self.stderr and not self.direct and name in self._stderr:
+        key, name = event.key, self.label(event)  # name: the package for the run's own kind (as colcon)
+        if self.cohesion and key in self._all:
+            self._print(f"--- output: {name}\n{self._all[key].decode(errors='replace').rstrip()}\n---")
+        elif self.stderr and not self.direct and key in self._stderr:
             where = f" (log: {self.log_path}/{task_log_folder(event, self.kind)}/stderr.log)" if self.log_path else ""
-            self._print(f"--- stderr: {name}{where}\n{self._stderr[name].decode(errors='replace').rstrip()}\n---")
+            self._print(f"--- stderr: {name}{where}\n{self._stderr[key].decode(errors='replace').rstrip()}\n---")
         if isinstance(event, TaskFinished):
             (self.cached if event.cached else self.finished).append(name)
             line = f"Finished <<< {name} [{'cached' if event.cached else format_duration(event.duration)}]"
             if self.finished_note:
-                line += self.finished_note(name)
+                line += self.finished_note(key)
         elif isinstance(event, TaskFailed):
             self.failed.append(name)
             reason = event.reason.strip().splitlines()[-1] if event.reason.strip() else "failed"
@@ -134,9 +147,12 @@ class ConsoleHandler:
         if self.skipped:
             causes = " ".join(f"{name} (needs {cause})" for name, cause in sorted(self.skipped.items()))
             lines.append(f"  {_count(len(self.skipped))} skipped because a dependency failed: {causes}")
-        with_stderr = sorted(self._stderr)
+        with_stderr = sorted(self._labels.get(key, key) for key in self._stderr)
         if with_stderr:
             lines.append(f"  {_count(len(with_stderr))} had stderr output: {' '.join(with_stderr)}")
+        if self.test_failures:
+            lines.append(f"  {_count(len(self.test_failures))} had test failures: "
+                         f"{' '.join(sorted(self.test_failures))}")
         if event.not_started:
             lines.append(f"  {_count(len(event.not_started))} not processed")
         if event.interrupted:

@@ -22,6 +22,7 @@ from roc.engine.events import (
     TaskFailed,
     TaskFinished,
     TaskOutput,
+    TestFailures,
     Tick,
 )
 from roc.fsutil import write_text_atomic
@@ -112,19 +113,29 @@ class LogHandler:
 
 # Where each kind of task leaves its result, as colcon does (other kinds keep none).
 RESULT_FILES = {"build": "colcon_build.rc", "test": "colcon_test.rc"}
+# colcon's result of a test task that finished with failing tests (--packages-select-test-failures).
+TEST_FAILURES_RESULT = "test failures"
 
 
 class ResultStore:
-    """Writes each package's result where --packages-select-build-failed (or -test-failures) looks."""
+    """Writes each package's result where --packages-select-build-failed (or -test-failures) looks:
+    0, 1, SIGINT, or "test failures" for a task that finished after a ``TestFailures`` event."""
 
     def __init__(self, build_base: Path):
         self.build_base = build_base
+        self.test_failures: set[str] = set()  # task keys
 
     def __call__(self, event: Event) -> None:
+        if isinstance(event, TestFailures):
+            self.test_failures.add(event.key)
+            return
         results = {TaskFinished: "0", TaskFailed: "1", TaskAborted: INTERRUPTED_RESULT}
         result = results.get(type(event))
-        if result is not None and event.kind in RESULT_FILES:
-            write_text_atomic(self.build_base / event.task / RESULT_FILES[event.kind], result + "\n")
+        if result is None or event.kind not in RESULT_FILES:
+            return
+        if result == "0" and event.key in self.test_failures:
+            result = TEST_FAILURES_RESULT
+        write_text_atomic(self.build_base / event.task / RESULT_FILES[event.kind], result + "\n")
 
 
 class JsonEventsHandler:

@@ -45,7 +45,8 @@ class StatusLine:
 
     MIN_INTERVAL = 0.25
 
-    def __init__(self, console=None, live=None, clock: Callable[[], float] = time.monotonic) -> None:
+    def __init__(self, console=None, live=None, clock: Callable[[], float] = time.monotonic,
+                 kind: str = "build") -> None:
         from rich.console import Console
         from rich.live import Live
 
@@ -53,12 +54,14 @@ class StatusLine:
         self.live = live or Live(console=self.console, auto_refresh=False, transient=True)
         self.live.start()
         self.clock = clock
+        self.kind = kind  # the run's own kind: its tasks are shown by name, others by key (idl:pkg)
         self.started = clock()
         self.drawn_text: str | None = None
         self.drawn_at = float("-inf")
         self.total = 0
         self.done = 0
-        self.running: dict[str, int | None] = {}
+        self.running: dict[str, int | None] = {}  # task key -> percent
+        self._labels: dict[str, str] = {}
 
     def print(self, text: str) -> None:
         self.console.print(text, markup=False, highlight=False, soft_wrap=True)
@@ -68,6 +71,7 @@ class StatusLine:
             self.total += 1
         elif isinstance(event, TaskStarted):
             self.running[event.key] = None
+            self._labels[event.key] = event.task if event.kind == self.kind else event.key
         elif isinstance(event, TaskOutput) and event.key in self.running:
             percent = progress_of(event.data)
             if percent is not None:
@@ -86,7 +90,8 @@ class StatusLine:
         now = self.clock()
         if now - self.drawn_at < self.MIN_INTERVAL:
             return
-        running = " ".join(f"{name}{f' {p}%' if p is not None else ''}" for name, p in self.running.items())
+        running = " ".join(f"{self._labels.get(key, key)}{f' {p}%' if p is not None else ''}"
+                           for key, p in self.running.items())
         line = f"[{int(now - self.started)}s] [{self.done}/{self.total} done] [{len(self.running)} running] {running}"
         line = line[: (self.console.width or 80) - 1]
         if line == self.drawn_text:

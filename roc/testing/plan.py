@@ -1,64 +1,91 @@
-"""Turn the selected packages into engine tasks that test them, with cached results."""
+"""Turn the selected packages into engine tasks (kind ``test``) that test them, with cached results.
+
+Whether a passing result is still valid is decided by each task's ``check``, when the task is
+dispatched: it returns why the package must be tested again (``never tested``, ``files changed: ...``,
+``--force``), or nothing for a cached result."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from roc.builder.environment import build_environment
+from roc.builder.fingerprint import combine
 from roc.buildtypes.context import BuildOptions
+from roc.engine.events import task_key
 from roc.engine.process import TaskContext
 from roc.engine.ready import Task
-from roc.testing.cache import passed_before, read_test_state, results_key, write_test_state
+from roc.testing.cache import (
+    read_test_state,
+    rerun_reasons,
+    results_parts,
+    write_test_state,
+)
 from roc.testing.results import collect_results
 from roc.testing.runner import TestOptions, run_package_tests
-from roc.workspace.dependencies import recursive_dependencies
 from roc.workspace.load import Workspace
 from roc.workspace.package import Package
+
+KIND = "test"
 
 
 def plan_tests(workspace: Workspace, options: TestOptions, weights: dict[str, float], force: bool = False,
                use_cache: bool = True) -> list[Task]:
     """One task per selected package, after the selected packages it depends on (as colcon orders
-    tests); a package that passed before with the same key is up to date (cached)."""
-    by_name = workspace.by_name
-    order = [p.name for p in workspace.ordered]
+    tests)."""
     tasks = []
     for package in workspace.selected_in_order():
-        recursive = recursive_dependencies(package, by_name)
-        dependencies = [n for n in order if n in recursive]
-        source = (workspace.root / package.path).resolve()
-        key, files, cached = None, {}, False
-        if use_cache:
-            state = read_test_state(options.build_base / package.name)
-            key, files = results_key(source, options.build_base, package.name, dependencies, options.digest(), state)
-            cached = not force and passed_before(state, key)
+        dependencies = workspace.dependencies.in_order(package.name)
+        test = PackageTest(package, (workspace.root / package.path).resolve(), dependencies, options, force,
+                           use_cache)
+        key = task_key(KIND, package.name)
         tasks.append(Task(
             name=package.name,
-            dependencies={n for n in dependencies if n in workspace.selected},
-            action=_test_action(package, source, dependencies, options, key if use_cache else None, files,
-                                use_cache),
-            weight=weights.get(package.name, 1.0),
-            check=lambda cached=cached: [] if cached else ["not passed before"],
+            dependencies={task_key(KIND, n) for n in dependencies if n in workspace.selected},
+            action=test.run,
+            kind=KIND,
+            weight=weights.get(key, 1.0),
+            check=test.check,
         ))
     return tasks
 
 
-def _test_action(package: Package, source: Path, dependencies: list[str], options: TestOptions, key: str | None,
-                 files: dict, use_cache: bool):
-    environment_options = BuildOptions(build_base=options.build_base, install_base=options.install_base,
-                                       merge_install=options.merge_install)
+class PackageTest:
+    """One package's test task: ``check`` (at dispatch) computes the key of the run and says why it must
+    run; ``run`` (in a worker) tests and records the outcome under that key."""
 
-    def action(context: TaskContext) -> None:
+    __test__ = False
+
+    def __init__(self, package: Package, source: Path, dependencies: list[str], options: TestOptions,
+                 force: bool = False, use_cache: bool = True):
+        self.package, self.source, self.dependencies, self.options = package, source, dependencies, options
+        self.force, self.use_cache = force, use_cache
+        self.build_dir = options.build_base / package.name
+        self.parts: dict | None = None
+        self.files: dict = {}
+
+    def check(self) -> list[str]:
+        if not self.use_cache:
+            return ["--no-cache"]
+        state = read_test_state(self.build_dir)
+        self.parts, self.files = results_parts(self.source, self.options.build_base, self.package.name,
+                                               self.dependencies, self.options.digest(), state)
+        if self.force:
+            return ["--force"]
+        return rerun_reasons(state, self.parts)
+
+    def run(self, context: TaskContext) -> None:
         # For testing, the package's own install prefix is part of its environment (as in colcon).
-        env = build_environment(package, [*dependencies, package.name], environment_options)
-        build_dir = options.build_base / package.name
-        build_dir.mkdir(parents=True, exist_ok=True)
-        if use_cache:
-            write_test_state(build_dir, None, False, files, [])
-        passed = run_package_tests(context, package.type, package.name, source, env, options)
-        if use_cache:
+        environment_options = BuildOptions(build_base=self.options.build_base,
+                                           install_base=self.options.install_base,
+                                           merge_install=self.options.merge_install)
+        env = build_environment(self.package, [*self.dependencies, self.package.name], environment_options)
+        self.build_dir.mkdir(parents=True, exist_ok=True)
+        if self.use_cache:
+            write_test_state(self.build_dir, None, False, self.files, [])
+        passed = run_package_tests(context, self.package.type, self.package.name, self.source, env, self.options)
+        if self.use_cache:
             results: set[str] = set()
-            collect_results(options.result_dir(package.name), files=results)
-            write_test_state(build_dir, key, passed, files, sorted(str(Path(p).absolute()) for p in results))
-
-    return action
+            collect_results(self.options.result_dir(self.package.name), files=results)
+            key = combine(self.parts) if self.parts else None
+            write_test_state(self.build_dir, key, passed, self.files, sorted(str(Path(p).absolute()) for p in results),
+                             self.parts)

@@ -10,7 +10,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
-from roc.engine.events import Event
+from roc.engine.events import TestFailures
 from roc.engine.process import TaskContext, TaskError
 
 CTEST_TESTS_FAILED = 8
@@ -18,13 +18,6 @@ PYTEST_TESTS_FAILED = 1
 PYTEST_NO_TESTS = 5
 CMAKE_TYPES = ("ros.ament_cmake", "ros.cmake", "cmake")
 PYTHON_TYPES = ("ros.ament_python", "python")
-
-
-@dataclass(frozen=True)
-class TestFailures(Event):
-    """The package's tests ran and some failed (the task itself still finishes, as in colcon)."""
-
-    __test__ = False
 
 
 @dataclass(frozen=True)
@@ -114,7 +107,7 @@ def _ctest(context: TaskContext, name: str, env: dict[str, str], options: TestOp
         if attempt == 0:
             args.append("--rerun-failed")
     if not passed:
-        context.emit(TestFailures(name))
+        context.emit(TestFailures(context.name, context.kind))
     _copy_ctest_results(tag_file, options.result_dir(name))
     return passed
 
@@ -185,7 +178,7 @@ def _pytest(context: TaskContext, name: str, source: Path, env: dict[str, str], 
     junit.write_text(MISSING_RESULT.format(name=name))  # replaced by pytest unless it fails early
     returncode = context.run([sys.executable, "-m", "pytest"], cwd=str(source), env=env)
     if returncode == PYTEST_TESTS_FAILED:
-        context.emit(TestFailures(name))
+        context.emit(TestFailures(context.name, context.kind))
         return False
     if returncode not in (0, PYTEST_NO_TESTS):
         raise TaskError(f"pytest exited with code {returncode}")
