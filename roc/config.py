@@ -242,7 +242,7 @@ def _load_roc_toml(config: Configuration, path: Path, verb: str, profile: str | 
             raise UsageError(f"{path}:{len(lines)}:{len(lines[-1]) + 1}: invalid TOML: "
                              f"{str(error).split(' (at ')[0]} (at the end of the file)") from None
         raise UsageError(f"{path}: invalid TOML: {error}") from None
-    known_tables = {"defaults", "profile", "package", *VERBS}
+    known_tables = {"defaults", "profile", "package", "check", *VERBS}  # [check]: roc.check.expectations
     for table, values in data.items():
         if table not in known_tables or not isinstance(values, dict):
             raise ConfigError(path, table, f"unknown table; {_closest(table, known_tables)}use [defaults], [{'], ['.join(VERBS)}], "

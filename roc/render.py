@@ -17,6 +17,13 @@ def print_lines(lines: Iterable[str], stream: TextIO | None = None) -> None:
     (stream or sys.stdout).write("".join(f"{line}\n" for line in lines))
 
 
+def print_text(text: str, stream: TextIO | None = None) -> None:
+    """Text as it is, flushed (for streams: each message as it arrives, also through a pipe)."""
+    out = stream or sys.stdout
+    out.write(text)
+    out.flush()
+
+
 def print_json(data: Any, stream: TextIO | None = None) -> None:
     """One JSON document, indented (for listings)."""
     out = stream or sys.stdout
@@ -24,11 +31,14 @@ def print_json(data: Any, stream: TextIO | None = None) -> None:
     out.write("\n")
 
 
+def json_line(data: Any) -> str:
+    """One compact JSON object and a newline."""
+    return json.dumps(data, separators=(",", ":")) + "\n"
+
+
 def print_json_line(data: Any, stream: TextIO | None = None) -> None:
     """One compact JSON object on one line, flushed (for streams: events, messages, status)."""
-    out = stream or sys.stdout
-    out.write(json.dumps(data, separators=(",", ":")) + "\n")
-    out.flush()
+    print_text(json_line(data), stream)
 
 
 def to_yaml(data: Any, flow_style: bool | None = False) -> str:

@@ -12,7 +12,8 @@ from build_helpers import BIN, ros_domain_id, stop_process
 
 NODE_SCRIPT = Path(__file__).resolve().parent / "graph_node.py"
 ORACLE_VENV = Path(os.environ.get("ROC_TEST_CACHE", Path.home() / ".cache" / "roc-tests")) / "ros2cli-venv"
-SHARED = Path(__file__).resolve().parents[2] / "shared"
+REPO = Path(__file__).resolve().parents[1]
+SHARED = REPO.parent / "shared"
 
 # The demo graph of shared/reference/ros2cli, in three processes.
 DEMO_GRAPH = [
@@ -67,20 +68,35 @@ def ros2(*args: str, env: dict[str, str], timeout: float = 60) -> subprocess.Com
                           timeout=timeout)
 
 
+# The message packages the oracle needs to echo and publish the tests' types, as requirements/ros-jazzy.txt pins them.
+ORACLE_INTERFACES = ("ros-jazzy-std-msgs", "ros-jazzy-common-interfaces", "ros-jazzy-std-srvs", "ros-jazzy-test-msgs")
+
+
 def install_oracle() -> str | None:
-    """Install the real ros2 CLI into the cached venv; the reason it failed, or None."""
-    if (ORACLE_VENV / "bin" / "ros2").exists():
+    """Install the real ros2 CLI and the tests' message packages into the cached venv; the reason it
+    failed, or None."""
+    python = ORACLE_VENV / "bin" / "python"
+    if (ORACLE_VENV / "bin" / "ros2").exists() and subprocess.run(
+            [str(python), "-c", "import geometry_msgs.msg, test_msgs.msg, std_srvs.srv"], capture_output=True,
+            env={**os.environ, "_ROS_WHEELS_BOOTSTRAP_COMPLETE": "1"}).returncode == 0:
         return None
     script = SHARED / "oracles" / "install_ros2cli.sh"
     if not script.is_file():
         return f"no oracle installer at {script}"
-    base = getattr(sys, "_base_executable", sys.executable)
-    made = subprocess.run([base, "-m", "venv", str(ORACLE_VENV)], capture_output=True, text=True)
-    if made.returncode != 0:
-        return f"cannot create {ORACLE_VENV}: {made.stderr.strip()}"
+    if not python.exists():
+        base = getattr(sys, "_base_executable", sys.executable)
+        made = subprocess.run([base, "-m", "venv", str(ORACLE_VENV)], capture_output=True, text=True)
+        if made.returncode != 0:
+            return f"cannot create {ORACLE_VENV}: {made.stderr.strip()}"
     installed = subprocess.run(["bash", str(script), str(ORACLE_VENV)], capture_output=True, text=True, timeout=900)
     if installed.returncode != 0:
         return f"install_ros2cli.sh failed: {installed.stderr.strip()[-300:]}"
+    pins = [line.strip() for line in (REPO / "requirements" / "ros-jazzy.txt").read_text().splitlines()
+            if line.strip().startswith(tuple(f"{name}==" for name in ORACLE_INTERFACES))]
+    added = subprocess.run([str(python), "-m", "pip", "install", "-q", *pins], capture_output=True, text=True,
+                           timeout=900)
+    if added.returncode != 0:
+        return f"installing {' '.join(pins)} into the oracle failed: {added.stderr.strip()[-300:]}"
     return None
 
 
@@ -94,3 +110,5 @@ def stop_daemon(env: dict[str, str]) -> None:
             os.kill(pid, 9)
         except ProcessLookupError:
             pass
+    if (ORACLE_VENV / "bin" / "ros2").exists():  # the oracle may have started its daemon in this domain
+        ros2("daemon", "stop", env=env)

@@ -2,7 +2,7 @@
 
     python graph_node.py '{"name": "talker", "namespace": "/", "publishers": [{"topic": "chatter",
         "type": "std_msgs/msg/String", "reliability": "best_effort", "durability": "volatile",
-        "depth": 10, "deadline_ms": 0}], "subscribers": [...], "services": [{"name": "reset",
+        "depth": 10, "deadline_ms": 0, "values": {"data": "hi"}, "rate_hz": 10}], "subscribers": [{..., "print": true}], "services": [{"name": "reset",
         "type": "std_srvs/srv/Trigger"}], "actions": [{"name": "fibonacci"}], "parameters": {"max_speed": 1.5}}'
 
 Several nodes in one process: pass a JSON list. Prints "ready" once everything is created, then
@@ -14,10 +14,13 @@ from __future__ import annotations
 import importlib
 import json
 import sys
+import time
 
 import rclpy
 from rclpy.duration import Duration
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.action import CancelResponse
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
@@ -37,13 +40,26 @@ def qos(spec: dict) -> QoSProfile:
 
 
 def make_node(spec: dict) -> Node:
-    node = Node(spec["name"], namespace=spec.get("namespace", "/"))
+    node = Node(spec["name"], namespace=spec.get("namespace", "/"),
+                allow_undeclared_parameters=spec.get("undeclared_parameters", False))
     for name, value in spec.get("parameters", {}).items():
         node.declare_parameter(name, value)
     for pub in spec.get("publishers", []):
-        node.create_publisher(load(pub["type"]), pub["topic"], qos(pub))
+        publisher = node.create_publisher(load(pub["type"]), pub["topic"], qos(pub))
+        if "values" in pub:  # {"data": "hello"}: published at once, then at "rate_hz" if given
+            message = load(pub["type"])(**pub["values"])
+            publisher.publish(message)
+            if pub.get("rate_hz"):
+                def tick(p=publisher, m=message, n=node, stamp=pub.get("stamp_now", False)) -> None:
+                    if stamp:  # a std_msgs/Header: stamped with the time of publication
+                        m.stamp = n.get_clock().now().to_msg()
+                    p.publish(m)
+                node.create_timer(1.0 / pub["rate_hz"], tick)
     for sub in spec.get("subscribers", []):
-        node.create_subscription(load(sub["type"]), sub["topic"], lambda _msg: None, qos(sub))
+        def received(msg, topic=sub["topic"], show=sub.get("print", False)) -> None:
+            if show:  # one line per message: the topic and the message's repr
+                print(json.dumps({"topic": topic, "message": repr(msg)}), flush=True)
+        node.create_subscription(load(sub["type"]), sub["topic"], received, qos(sub))
     for srv in spec.get("services", []):
         node.create_service(load(srv["type"]), srv["name"], lambda _req, resp: resp)
     for client in spec.get("clients", []):
@@ -52,14 +68,36 @@ def make_node(spec: dict) -> Node:
         from rclpy.action import ActionServer
 
         node._roc_action = ActionServer(node, load(action.get("type", "test_msgs/action/Fibonacci")),
-                                        action["name"], lambda goal: None)
+                                        action["name"], fibonacci(action.get("step_seconds", 0.0)),
+                                        callback_group=ReentrantCallbackGroup(),
+                                        cancel_callback=lambda _goal: CancelResponse.ACCEPT)
     return node
+
+
+def fibonacci(step_seconds: float):
+    """A test_msgs/action/Fibonacci server: feedback after each number, ``step_seconds`` apart; a
+    canceled goal ends canceled, and prints ``canceled``."""
+    def execute(goal_handle):
+        from test_msgs.action import Fibonacci
+
+        sequence = [0, 1]
+        for _ in range(max(0, goal_handle.request.order - 1)):
+            if goal_handle.is_cancel_requested:
+                goal_handle.canceled()
+                print("canceled", flush=True)
+                return Fibonacci.Result(sequence=sequence)
+            sequence.append(sequence[-1] + sequence[-2])
+            goal_handle.publish_feedback(Fibonacci.Feedback(sequence=sequence))
+            time.sleep(step_seconds)
+        goal_handle.succeed()
+        return Fibonacci.Result(sequence=sequence)
+    return execute
 
 
 def main() -> None:
     specs = json.loads(sys.argv[1])
     rclpy.init()
-    executor = SingleThreadedExecutor()
+    executor = MultiThreadedExecutor()  # an action's execute callback may run while others are served
     for spec in specs if isinstance(specs, list) else [specs]:
         executor.add_node(make_node(spec))
     print("ready", flush=True)

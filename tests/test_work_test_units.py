@@ -153,10 +153,15 @@ def test_console_names_the_runs_own_kind_as_colcon_and_other_kinds_by_key() -> N
     build = io.StringIO()
     console = ConsoleHandler(build, kind="build")
     for event in (TaskQueued("a", "idl"), TaskStarted("a", "idl"), TaskFinished("a", "idl", duration=1.0),
-                  TaskStarted("a"), TaskFinished("a", duration=1.0)):
+                  TaskStarted("a"), TaskFinished("a", duration=1.0), TaskQueued("b", "idl"),
+                  TaskFinished("b", "idl", cached=True), TaskFinished("b", cached=True), TaskQueued("c"),
+                  RunFinished("", not_started=("idl:c", "c"))):
         console(event)
-    assert build.getvalue().splitlines() == ["Starting >>> idl:a", "Finished <<< idl:a [1.00s]",
-                                             "Starting >>> a", "Finished <<< a [1.00s]"]
+    lines = build.getvalue().splitlines()
+    assert lines[:4] == ["Starting >>> idl:a", "Finished <<< idl:a [1.00s]", "Starting >>> a", "Finished <<< a [1.00s]"]
+    assert lines[5].startswith("Summary: 2 packages and 2 idl tasks finished [")
+    assert lines[6:] == ["  1 package and 1 idl task up to date (not rebuilt): b idl:b",
+                         "  1 package and 1 idl task not processed"]
 
 
 def test_status_line_names_the_runs_own_kind_by_package() -> None:

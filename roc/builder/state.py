@@ -14,19 +14,23 @@ from roc.messages import warn
 STATE_FILE = "roc_state.json"
 
 
-def read_state(build_dir: Path) -> dict:
-    path = build_dir / STATE_FILE
+def read_record(path: Path, damaged: str, fields: tuple[str, ...] = ("files",)) -> dict:
+    """A JSON state record: {} when there is none; {} and the warning ``<path>: <damaged>`` when it is
+    not an object whose ``fields`` (where present) are objects."""
     try:
         state = json.loads(path.read_text())
     except FileNotFoundError:
         return {}
     except (OSError, ValueError):
-        warn(f"{path}: damaged build state; the package will be rebuilt")
-        return {}
-    if not isinstance(state, dict) or not isinstance(state.get("files", {}), dict):
-        warn(f"{path}: damaged build state; the package will be rebuilt")
-        return {}
-    return state
+        state = None
+    if isinstance(state, dict) and all(isinstance(state.get(field, {}), dict) for field in fields):
+        return state
+    warn(f"{path}: {damaged}")
+    return {}
+
+
+def read_state(build_dir: Path) -> dict:
+    return read_record(build_dir / STATE_FILE, "damaged build state; the package will be rebuilt")
 
 
 def write_state(build_dir: Path, fingerprint: str | None, files: dict, parts: dict | None = None) -> None:

@@ -115,7 +115,41 @@ def rewrite_passthrough(argv: list[str], known_options: set[str]) -> list[str]:
 def add_graph_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of every verb that queries the ROS graph."""
     add_format_argument(parser)
+    add_discovery_arguments(parser)
+
+
+def add_discovery_arguments(parser: argparse.ArgumentParser) -> None:
+    """How a graph verb reaches the graph: through the roc daemon, or discovering it itself."""
     parser.add_argument("--no-daemon", action="store_true", help="do not use (or start) the roc daemon")
     parser.add_argument("--spin-time", type=float, metavar="SECONDS",
                         help="without the daemon: how long to discover the graph (default: 3.5, one DDS "
                              "announcement period; less may miss processes)")
+
+
+QOS_PROFILES = ("unknown", "default", "system_default", "sensor_data", "services_default", "parameters",
+                "parameter_events", "action_status_default", "best_available")
+QOS_POLICIES = {
+    "history": ("system_default", "keep_last", "keep_all", "unknown"),
+    "reliability": ("system_default", "reliable", "best_effort", "unknown", "best_available"),
+    "durability": ("system_default", "transient_local", "volatile", "unknown", "best_available"),
+    "liveliness": ("system_default", "automatic", "manual_by_topic", "unknown", "best_available"),
+}
+
+
+def add_qos_arguments(parser: argparse.ArgumentParser, default_profile: str, verb: str) -> None:
+    """ros2's QoS options of ``topic echo`` / ``topic pub``; reliability and durability not given follow
+    the topic's publishers (echo)."""
+    parser.add_argument("--qos-profile", choices=QOS_PROFILES, default=default_profile,
+                        help=f"QoS preset profile to {verb} with (default: {default_profile})")
+    parser.add_argument("--qos-depth", type=int, metavar="N", help="queue size (overrides the profile's)")
+    for policy, choices in QOS_POLICIES.items():
+        parser.add_argument(f"--qos-{policy}", choices=choices, help=f"{policy} (overrides the profile's)")
+    parser.add_argument("--qos-liveliness-lease-duration-seconds", type=float, metavar="SECONDS",
+                        help="liveliness lease duration (overrides the profile's)")
+
+
+def qos_options(args: argparse.Namespace) -> dict:
+    """The QoS options as roc.ros.dataplane.qos_profile takes them."""
+    return {"profile": args.qos_profile, "depth": args.qos_depth,
+            "liveliness_lease_seconds": args.qos_liveliness_lease_duration_seconds,
+            **{policy: getattr(args, f"qos_{policy}") for policy in QOS_POLICIES}}

@@ -89,6 +89,17 @@ class TestFailures(Event):
 
 
 @dataclass(frozen=True)
+class ProbeResult(Event):
+    """A probe's verdict (``pass``, ``fail``, ``error``), sent before its task ends: what it found
+    (``message``, ``measured``) and what was expected."""
+
+    status: str = "pass"
+    message: str = ""
+    expected: dict = field(default_factory=dict, hash=False)
+    measured: object = field(default=None, hash=False)
+
+
+@dataclass(frozen=True)
 class RunFinished(Event):
     """The whole run ended; ``task`` is empty."""
 

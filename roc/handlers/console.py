@@ -30,8 +30,23 @@ def format_duration(seconds: float) -> str:
     return f"{minutes}min {rest}s"
 
 
-def _count(n: int, word: str = "package") -> str:
+def _plural(n: int, word: str) -> str:
     return f"{n} {word}{'' if n == 1 else 's'}"
+
+
+def _count(labels: list[str], noun: str = "package") -> str:
+    """``3 packages``, or ``2 packages and 1 idl task``: a task of the run's own kind is labelled by
+    what it works on (a ``noun``: package, probe), one of another kind by its key ``kind:name`` (such
+    labels hold no colon)."""
+    packages = [label for label in labels if ":" not in label]
+    other_kinds: dict[str, int] = {}
+    for label in labels:
+        if ":" in label:
+            kind = label.split(":", 1)[0]
+            other_kinds[kind] = other_kinds.get(kind, 0) + 1
+    parts = [_plural(len(packages), noun)] if packages or not other_kinds else []
+    parts += [_plural(n, f"{kind} task") for kind, n in sorted(other_kinds.items())]
+    return " and ".join(parts)
 
 
 class ConsoleHandler:
@@ -45,8 +60,9 @@ class ConsoleHandler:
     def __init__(self, stream: TextIO = sys.stdout, *, start_end: bool = True, stderr: bool = True,
                  summary: bool = True, direct: bool = False, cohesion: bool = False, log_path: str | None = None,
                  status=None, kind: str = "build", cached_label: str = "up to date (not rebuilt)",
-                 finished_note=None):
+                 finished_note=None, noun: str = "package"):
         self.stream = stream
+        self.noun = noun  # what a task of the run's own kind is, in the summary
         self.cached_label = cached_label  # how the summary names tasks that finished without running
         self.finished_note = finished_note  # (task key) -> text appended to its "Finished" line
         self.status = status  # a StatusLine on a terminal: lines are printed above it
@@ -136,25 +152,25 @@ class ConsoleHandler:
 
     def _print_summary(self, event: RunFinished) -> None:
         total = format_duration(time.monotonic() - self.started_at)
-        lines = ["", f"Summary: {_count(len(self.finished) + len(self.cached))} finished [{total}]"]
+        lines = ["", f"Summary: {_count(self.finished + self.cached, self.noun)} finished [{total}]"]
         if self.cached:
             names = f": {' '.join(sorted(self.cached))}" if len(self.cached) <= 10 else ""
-            lines.append(f"  {_count(len(self.cached))} {self.cached_label}{names}")
+            lines.append(f"  {_count(self.cached, self.noun)} {self.cached_label}{names}")
         if self.failed:
-            lines.append(f"  {_count(len(self.failed))} failed: {' '.join(sorted(self.failed))}")
+            lines.append(f"  {_count(self.failed, self.noun)} failed: {' '.join(sorted(self.failed))}")
         if self.aborted:
-            lines.append(f"  {_count(len(self.aborted))} aborted: {' '.join(sorted(self.aborted))}")
+            lines.append(f"  {_count(self.aborted, self.noun)} aborted: {' '.join(sorted(self.aborted))}")
         if self.skipped:
             causes = " ".join(f"{name} (needs {cause})" for name, cause in sorted(self.skipped.items()))
-            lines.append(f"  {_count(len(self.skipped))} skipped because a dependency failed: {causes}")
+            lines.append(f"  {_count(list(self.skipped), self.noun)} skipped because a dependency failed: {causes}")
         with_stderr = sorted(self._labels.get(key, key) for key in self._stderr)
         if with_stderr:
-            lines.append(f"  {_count(len(with_stderr))} had stderr output: {' '.join(with_stderr)}")
+            lines.append(f"  {_count(with_stderr, self.noun)} had stderr output: {' '.join(with_stderr)}")
         if self.test_failures:
-            lines.append(f"  {_count(len(self.test_failures))} had test failures: "
+            lines.append(f"  {_count(self.test_failures, self.noun)} had test failures: "
                          f"{' '.join(sorted(self.test_failures))}")
         if event.not_started:
-            lines.append(f"  {_count(len(event.not_started))} not processed")
+            lines.append(f"  {_count(list(event.not_started), self.noun)} not processed")
         if event.interrupted:
             lines.append("  interrupted by the user")
         self._print("\n".join(lines))

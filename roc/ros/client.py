@@ -213,3 +213,72 @@ def query(method: str, params: dict[str, Any] | None = None, *, use_daemon: bool
         return connection.request(method, params)
     finally:
         connection.close()
+
+
+def stream(method: str, params: dict[str, Any], *, use_daemon: bool = True, heartbeats: bool = False,
+           **local: Any) -> Iterator[dict[str, Any]]:
+    """The events of a streaming request (roc.ros.dataplane), in the daemon unless ``use_daemon`` is
+    false (``local``: options of roc.ros.dataplane.local_stream), or in this process when the daemon
+    cannot import the type; closing the iterator (or Ctrl+C) ends the stream and removes its endpoint.
+    ``heartbeats``: pass on the heartbeat events too (at least every 0.5 s, to act between events)."""
+    skipped = () if heartbeats else ("heartbeat",)
+    if not use_daemon:
+        from roc.ros.dataplane import local_stream
+
+        events = local_stream(method, params, **local)
+        yield from (event for event in events if event.get("event") not in skipped)
+        return
+    connection = start_daemon()
+    try:
+        started = False
+        for response in connection.stream(method, params):
+            error = response.get("error")
+            if error and error.get("kind") == "UnknownTypeError" and not started:
+                break  # a type the daemon's environment lacks (an overlay sourced since it started)
+            if error:
+                raise DaemonError(error["message"])
+            if response.get("event") is not None and response["event"] not in skipped:
+                started = True
+                yield response
+        else:
+            return
+    finally:
+        connection.close()
+    yield from stream(method, params, use_daemon=False, heartbeats=heartbeats, **local)
+
+
+class Session:
+    """Many queries and streams on one participant: the daemon's, or (``use_daemon`` false) one of
+    this process, discovered once (see roc.ros.graph.Graph). For callers that probe a graph many
+    times, e.g. ``roc graph check``; thread-safe."""
+
+    def __init__(self, use_daemon: bool = True, spin_time: float | None = None):
+        self.use_daemon = use_daemon
+        self.graph = None
+        if use_daemon:
+            start_daemon().close()
+        else:
+            from roc.ros.graph import DEFAULT_SPIN_TIME, Graph
+
+            self.graph = Graph()
+            self.graph.wait_for_discovery(spin_time if spin_time is not None else DEFAULT_SPIN_TIME)
+
+    def query(self, method: str, params: dict[str, Any] | None = None) -> Any:
+        if self.graph is not None:
+            return self.graph.handle(method, params or {})
+        return query(method, params)
+
+    def stream(self, method: str, params: dict[str, Any], heartbeats: bool = False) -> Iterator[dict[str, Any]]:
+        if self.graph is None:
+            yield from stream(method, params, heartbeats=heartbeats)
+            return
+        import contextlib
+
+        from roc.ros.dataplane import STREAMS
+
+        with contextlib.closing(STREAMS[method](self.graph, params)) as events:
+            yield from (event for event in events if heartbeats or event.get("event") != "heartbeat")
+
+    def close(self) -> None:
+        if self.graph is not None:
+            self.graph.close()

@@ -5,6 +5,7 @@ requests on a Unix socket (mode 0600). Started by roc.ros.client; run as
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
@@ -84,15 +85,21 @@ class Daemon:
                     request_id = request.get("id")
                 except (json.JSONDecodeError, AttributeError):
                     request, request_id = {}, None
-                for response in self._answer(request):
-                    response["id"] = request_id
-                    conn.sendall((json.dumps(response) + "\n").encode())
+                # Closed as soon as the client is gone, so a stream's endpoint goes with it.
+                with contextlib.closing(self._answer(request)) as responses:
+                    try:
+                        for response in responses:
+                            response["id"] = request_id
+                            conn.sendall((json.dumps(response) + "\n").encode())
+                            self.last_request = time.monotonic()
+                    except OSError:
+                        return
                 if request.get("method") == "shutdown":
                     return
 
     def _answer(self, request: dict[str, Any]):
         """The response lines of one request; the last carries ``final: true``. Streaming requests
-        (a later issue) yield ``{"event": ...}`` lines before it."""
+        (roc.ros.dataplane) yield ``{"event": ...}`` lines before it."""
         method = request.get("method")
         try:
             if method == "hello":
@@ -106,7 +113,14 @@ class Daemon:
             else:
                 if not self.ready.wait(30):
                     raise RocError("the daemon's graph participant did not start")
-                result = self.graph.handle(method, request.get("params") or {})
+                from roc.ros.dataplane import STREAMS
+
+                params = request.get("params") or {}
+                if method in STREAMS:
+                    yield from STREAMS[method](self.graph, params)
+                    result = None
+                else:
+                    result = self.graph.handle(method, params)
             yield {"final": True, "result": result}
         except RocError as error:
             yield {"final": True, "error": {"kind": type(error).__name__, "message": str(error)}}

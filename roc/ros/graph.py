@@ -79,10 +79,10 @@ def full_name(namespace: str, name: str) -> str:
 class Graph:
     """A hidden rclpy node in its own context, spun in a background thread (for service calls)."""
 
-    def __init__(self) -> None:
+    def __init__(self, node_name: str | None = None) -> None:
         self.context = Context()
         rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)
-        self.node = Node(f"_roc_{os.getpid()}", context=self.context, start_parameter_services=False,
+        self.node = Node(node_name or f"_roc_{os.getpid()}", context=self.context, start_parameter_services=False,
                          enable_rosout=False)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
@@ -193,7 +193,8 @@ class Graph:
         return {"name": action, "servers": servers, "clients": clients}
 
     # -- parameters (service calls to the node) ------------------------------------------------------
-    def _call(self, node_name: str, service: str, srv_type, request) -> Any:
+    def call_node_service(self, node_name: str, service: str, srv_type, request) -> Any:
+        """Call the node's service ``service`` (e.g. ``set_parameters``) and return the response."""
         try:
             self._find_node(node_name)
         except NotFound:
@@ -215,25 +216,25 @@ class Graph:
         from rcl_interfaces.srv import ListParameters
 
         request = ListParameters.Request(prefixes=prefixes or [], depth=0)
-        return sorted(self._call(node_name, "list_parameters", ListParameters, request).result.names)
+        return sorted(self.call_node_service(node_name, "list_parameters", ListParameters, request).result.names)
 
     def param_values(self, node_name: str, names: list[str]) -> list[dict[str, Any]]:
         from rcl_interfaces.srv import GetParameters
 
-        response = self._call(node_name, "get_parameters", GetParameters, GetParameters.Request(names=names))
+        response = self.call_node_service(node_name, "get_parameters", GetParameters, GetParameters.Request(names=names))
         return [parameter_value(v) for v in response.values]
 
     def param_types(self, node_name: str, names: list[str]) -> list[int]:
         from rcl_interfaces.srv import GetParameterTypes
 
         request = GetParameterTypes.Request(names=names)
-        return list(self._call(node_name, "get_parameter_types", GetParameterTypes, request).types)
+        return list(self.call_node_service(node_name, "get_parameter_types", GetParameterTypes, request).types)
 
     def param_descriptors(self, node_name: str, names: list[str]) -> list[dict[str, Any]]:
         from rcl_interfaces.srv import DescribeParameters
 
         request = DescribeParameters.Request(names=names)
-        response = self._call(node_name, "describe_parameters", DescribeParameters, request)
+        response = self.call_node_service(node_name, "describe_parameters", DescribeParameters, request)
         return [{
             "name": d.name, "type": PARAMETER_TYPES.get(d.type, "not set"), "description": d.description,
             "additional_constraints": d.additional_constraints, "read_only": d.read_only,
@@ -283,19 +284,23 @@ class Graph:
         if method == "param_dump":
             names = self.param_names(params["node"])
             return dict(zip(names, self.param_values(params["node"], names)))
+        from roc.ros.params import WRITES
+
+        if method in WRITES:
+            return WRITES[method](self, params)
         raise RocError(f"unknown request '{method}'")
 
 
 PARAMETER_TYPES = {0: "not set", 1: "boolean", 2: "integer", 3: "double", 4: "string", 5: "byte array",
                    6: "boolean array", 7: "integer array", 8: "double array", 9: "string array"}
-_VALUE_FIELDS = {1: "bool_value", 2: "integer_value", 3: "double_value", 4: "string_value",
+VALUE_FIELDS = {1: "bool_value", 2: "integer_value", 3: "double_value", 4: "string_value",
                  5: "byte_array_value", 6: "bool_array_value", 7: "integer_array_value",
                  8: "double_array_value", 9: "string_array_value"}
 
 
 def parameter_value(value) -> dict[str, Any]:
     """{type, value} of an rcl_interfaces ParameterValue, the value as plain JSON data."""
-    field = _VALUE_FIELDS.get(value.type)
+    field = VALUE_FIELDS.get(value.type)
     data = getattr(value, field) if field else None
     if field == "byte_array_value":
         data = [b if isinstance(b, int) else ord(b) for b in data]

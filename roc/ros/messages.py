@@ -92,6 +92,12 @@ def message_to_dict(msg: Any, *, no_arr: bool = False, no_str: bool = False,
             for name, slot in fields(type(msg))}
 
 
+def value_to_data(value: Any, *, no_arr: bool = False, no_str: bool = False,
+                  truncate_length: int | None = None) -> Any:
+    """A message or a field value (``echo --field``) as plain data."""
+    return _to_data(value, None, no_arr, no_str, truncate_length)
+
+
 def _to_data(value: Any, slot: Any, no_arr: bool, no_str: bool, limit: int | None) -> Any:
     if isinstance(value, (bool, int, float)):
         return value.item() if isinstance(value, numpy.generic) else value

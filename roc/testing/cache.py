@@ -7,23 +7,14 @@ import json
 from pathlib import Path
 
 from roc.builder.fingerprint import changes, combine, source_parts, source_stamps
-from roc.builder.state import read_state
+from roc.builder.state import read_record, read_state
 from roc.fsutil import write_text_atomic
-from roc.messages import warn
 
 TEST_STATE_FILE = "roc_test_state.json"
 
 
 def read_test_state(build_dir: Path) -> dict:
-    path = build_dir / TEST_STATE_FILE
-    try:
-        state = json.loads(path.read_text())
-    except FileNotFoundError:
-        return {}
-    except (OSError, ValueError):
-        warn(f"{path}: damaged test state; the package will be tested again")
-        return {}
-    return state if isinstance(state, dict) and isinstance(state.get("files", {}), dict) else {}
+    return read_record(build_dir / TEST_STATE_FILE, "damaged test state; the package will be tested again")
 
 
 def results_parts(source: Path, build_base: Path, name: str, dependencies: list[str], options: dict,

@@ -1,0 +1,41 @@
+#!/usr/bin/env python3
+"""A paced publisher for dataplane_bench.py: std_msgs/String on TOPIC at RATE Hz for SECONDS seconds,
+after WAIT seconds (for the consumers to subscribe). Prints the count and the true rate as JSON.
+
+    python bench/paced_publisher.py TOPIC RATE SECONDS WAIT
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+
+import rclpy
+from rclpy.qos import QoSProfile
+from std_msgs.msg import String
+
+
+def main() -> None:
+    topic, rate, seconds, wait = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
+    rclpy.init()
+    node = rclpy.create_node("paced_publisher")
+    publisher = node.create_publisher(String, topic, QoSProfile(depth=1000))
+    message = String(data="x" * 64)
+    time.sleep(wait)
+    period, count = 1.0 / rate, 0
+    start = time.perf_counter()
+    while (now := time.perf_counter()) - start < seconds:
+        due = start + count * period
+        if now < due:  # sleep, not spin: the consumers share the machine's cores
+            time.sleep(due - now)
+        publisher.publish(message)
+        count += 1
+    elapsed = time.perf_counter() - start
+    print(json.dumps({"count": count, "rate": count / elapsed}), flush=True)
+    node.destroy_node()
+    rclpy.shutdown()
+
+
+if __name__ == "__main__":
+    main()

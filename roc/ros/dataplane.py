@@ -1,0 +1,361 @@
+"""Moving data on a live graph: a subscription (``echo``) and a publisher (``publish``) on a Graph's
+node, each a stream of plain-data events. The same generators run inside the roc daemon (each event a
+line on the client's socket, so the endpoint lives in an already discovered participant) and in a
+daemon-less run. Messages travel as serialised CDR (base64 in JSON); the client turns them into
+message objects (``decode``), so the daemon never needs a verb's output options.
+
+A stream ends when its generator is closed: the daemon closes it when the client goes away (a
+heartbeat event at least every HEARTBEAT_SECONDS finds out), and the ``finally`` blocks destroy the
+endpoint, so an interrupted client leaves none behind.
+"""
+
+from __future__ import annotations
+
+import base64
+import contextlib
+import queue
+import struct
+import threading
+import time
+from collections.abc import Callable, Iterator
+from typing import Any
+
+from rclpy.qos import (
+    DurabilityPolicy,
+    HistoryPolicy,
+    LivelinessPolicy,
+    QoSPresetProfiles,
+    QoSProfile,
+    ReliabilityPolicy,
+)
+from rclpy.serialization import deserialize_message, serialize_message
+
+from roc.errors import RocError
+from roc.ros.types import action_class, message_class, service_class
+
+HEARTBEAT_SECONDS = 0.5
+MAX_BATCH = 1000  # messages in one ``messages`` event
+POLL_SECONDS = 0.05
+_POLICIES = {"history": HistoryPolicy, "reliability": ReliabilityPolicy, "durability": DurabilityPolicy,
+             "liveliness": LivelinessPolicy}
+
+
+def qos_profile(options: dict[str, Any], publishers: list | None = None) -> QoSProfile:
+    """The profile ``options`` ask for (``profile``, ``depth``, ``history``, ``reliability``,
+    ``durability``, ``liveliness``, ``liveliness_lease_seconds``). Reliability and durability not given
+    follow ``publishers`` (rclpy endpoint infos) as ros2 does: reliable / transient local only when
+    every publisher is."""
+    profile = QoSPresetProfiles.get_from_short_key(options.get("profile", "default"))
+    profile = QoSProfile(**{slot.lstrip("_"): getattr(profile, slot) for slot in profile.__slots__})
+    for name, policy in _POLICIES.items():
+        if options.get(name):
+            setattr(profile, name, policy.get_from_short_key(options[name]))
+    if options.get("depth") is not None:
+        profile.depth = options["depth"]
+    if options.get("liveliness_lease_seconds") is not None:
+        from rclpy.duration import Duration
+
+        profile.liveliness_lease_duration = Duration(seconds=options["liveliness_lease_seconds"])
+    if publishers:
+        if not options.get("reliability"):
+            reliable = all(p.qos_profile.reliability == ReliabilityPolicy.RELIABLE for p in publishers)
+            profile.reliability = ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT
+        if not options.get("durability"):
+            latched = all(p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for p in publishers)
+            profile.durability = DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE
+    return profile
+
+
+def decode(message_type: str | type, data: str) -> Any:
+    """A message object (a message type's name, or a class such as a service's Response) from base64
+    CDR, as stream events carry messages."""
+    cls = message_class(message_type) if isinstance(message_type, str) else message_type
+    return deserialize_message(base64.b64decode(data), cls)
+
+
+def serialize(message: Any) -> bytes:
+    """A message's CDR, as a raw publisher sends it."""
+    return serialize_message(message)
+
+
+def encode(message: Any) -> str:
+    """The base64 CDR of a message, for a ``publish`` request."""
+    return base64.b64encode(serialize(message)).decode()
+
+
+def publishers(graph, topic: str, wait: float) -> list:
+    """The topic's publishers (rclpy endpoint infos), waiting up to ``wait`` seconds for one to appear
+    (a fresh participant discovers them)."""
+    deadline = time.monotonic() + wait
+    while True:
+        found = graph.node.get_publishers_info_by_topic(topic)
+        if found or time.monotonic() >= deadline:
+            return found
+        time.sleep(POLL_SECONDS)
+
+
+def _graph_type(graph, topic: str) -> str | None:
+    return next((types[0] for name, types in graph.node.get_topic_names_and_types() if name == topic), None)
+
+
+def _topic_class(graph, topic: str, params: dict[str, Any], wait_for_type: bool):
+    """Events while the topic's publishers and type are looked up (``not_published {topic}``, and
+    heartbeats while waiting for a type with ``wait_for_type``); returns (class, type name, publishers).
+    The type is resolved before any event, so that a type the daemon lacks is found first (client.stream)."""
+    found = publishers(graph, topic, params.get("wait", 0.0))
+    type_name = params.get("type") or _graph_type(graph, topic)
+    cls = message_class(type_name) if type_name else None
+    if not found:
+        yield {"event": "not_published", "topic": topic}
+    while cls is None and wait_for_type:  # as ros2 topic hz: until the topic appears
+        yield {"event": "heartbeat"}
+        time.sleep(POLL_SECONDS)
+        type_name = _graph_type(graph, topic)
+        cls = message_class(type_name) if type_name else None
+        found = graph.node.get_publishers_info_by_topic(topic)
+    if cls is None:
+        raise RocError("Could not determine the type for the passed topic")
+    return cls, type_name, found
+
+
+def echo(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+    """Subscribe to ``params["topic"]`` and yield ``{"event": "messages", "messages": [{data, info,
+    lost}]}`` with what arrived since the last event (``lost``: messages the publisher's sequence
+    numbers say never arrived), ``{"event": "subscribed", "type"}`` first and heartbeats in between.
+    Params: ``topic``, ``wait`` (seconds to wait for a publisher to be discovered), ``type`` (else the
+    graph's), ``qos`` (see qos_profile), ``timeout`` (seconds for the first message; then ``{"event":
+    "timeout"}`` ends the stream)."""
+    topic = params["topic"]
+    cls, type_name, found = yield from _topic_class(graph, topic, params, wait_for_type=False)
+    arrived: queue.SimpleQueue = queue.SimpleQueue()
+    subscription = graph.node.create_subscription(
+        cls, topic, lambda data, info: arrived.put((data, info)), qos_profile(params.get("qos", {}), found), raw=True)
+    try:
+        yield {"event": "subscribed", "type": type_name}
+        last_sequence: int | None = None
+        timeout = params.get("timeout")
+        deadline = time.monotonic() + timeout if timeout is not None else None
+        while True:
+            try:
+                batch = [arrived.get(timeout=HEARTBEAT_SECONDS)]
+            except queue.Empty:
+                if deadline is not None and time.monotonic() >= deadline:
+                    yield {"event": "timeout"}
+                    return
+                yield {"event": "heartbeat"}
+                continue
+            deadline = None  # a message arrived: the timeout is over
+            while len(batch) < MAX_BATCH and not arrived.empty():  # a backlog goes as one event
+                batch.append(arrived.get())
+            messages = []
+            for data, info in batch:
+                sequence = info.get("publication_sequence_number")
+                lost = 0
+                if sequence is not None and last_sequence is not None and sequence > last_sequence + 1:
+                    lost = sequence - last_sequence - 1  # a lower number: another publisher, nothing lost
+                last_sequence = sequence
+                messages.append({"data": base64.b64encode(data).decode(), "lost": lost,
+                                 "info": {key: value for key, value in info.items() if value is not None}})
+            yield {"event": "messages", "messages": messages}
+    finally:
+        graph.node.destroy_subscription(subscription)
+
+
+def publish(graph, params: dict[str, Any], prepare: Callable[[], bytes] | None = None) -> Iterator[dict[str, Any]]:
+    """Publish ``params["data"]`` (base64 CDR of a ``type`` message) on ``topic``: wait for ``wait``
+    matching subscriptions (``{"event": "waiting"}`` each second, at most ``max_wait`` seconds), then
+    ``times`` messages (0: until closed) at ``rate`` Hz, ``{"event": "published", "count"}`` after each,
+    keeping the publisher ``keep_alive`` seconds after the last. In-process only: ``prepare`` gives the
+    CDR to send before each message (stamped with the time)."""
+    cls = message_class(params["type"])
+    data = base64.b64decode(params["data"])
+    profile = qos_profile({"profile": "default", **params.get("qos", {})})
+    publisher = graph.node.create_publisher(cls, params["topic"], profile)
+    try:
+        wanted, max_wait = params.get("wait", 0), params.get("max_wait")
+        started = next_notice = time.monotonic()
+        while publisher.get_subscription_count() < wanted:
+            now = time.monotonic()
+            if max_wait is not None and now - started >= max_wait:
+                raise RocError(f"Timed out waiting for subscribers: Expected {wanted} subscribers but only got "
+                               f"{publisher.get_subscription_count()} subscribers")
+            if now >= next_notice:
+                yield {"event": "waiting", "subscriptions": wanted}
+                next_notice += 1.0
+            time.sleep(POLL_SECONDS)
+        yield {"event": "started"}
+        times, period = params.get("times", 0), 1.0 / params["rate"] if params.get("rate") else 1.0
+        count, due = 0, time.monotonic()
+        while not times or count < times:
+            publisher.publish(prepare() if prepare is not None else data)
+            count += 1
+            yield {"event": "published", "count": count}
+            if times and count == times:
+                break
+            due += period
+            while (remaining := due - time.monotonic()) > 0:
+                time.sleep(min(remaining, HEARTBEAT_SECONDS))
+                if remaining > HEARTBEAT_SECONDS:
+                    yield {"event": "heartbeat"}
+        time.sleep(params.get("keep_alive", 0.1))
+    finally:
+        graph.node.destroy_publisher(publisher)
+
+
+def header_stamp_ns(data: bytes) -> int | None:
+    """The ``header.stamp`` of a message whose first field is a std_msgs/Header, read from its CDR
+    (encapsulation, then int32 sec and uint32 nanosec) without deserialising it."""
+    if len(data) < 12:
+        return None
+    order = "<" if data[1] & 1 else ">"
+    sec, nanosec = struct.unpack(order + "iI", data[4:12])
+    return sec * 1_000_000_000 + nanosec
+
+
+def stats(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+    """Subscribe to each of ``params["topics"]`` and yield, every ``period`` seconds, a ``batch`` of
+    what arrived: per topic, lists of publication sequence numbers, source and reception timestamps
+    (ns), serialised sizes and, with ``stamps``, header stamps (ns) — never deserialising a message,
+    so that a fast topic does not outrun the subscriber. ``subscribed {topic, type}`` (or
+    ``not_published {topic}``, then heartbeats until the topic appears) first, per topic."""
+    period = params.get("period", 1.0)
+    columns = ("sequence", "source", "received", "size", "stamp")
+    arrived: dict[str, dict[str, list]] = {}
+    subscriptions = []
+    lock = threading.Lock()
+
+    def record(topic: str, data: bytes, info: dict) -> None:
+        stamp = header_stamp_ns(data) if params.get("stamps") else None
+        with lock:
+            batch = arrived[topic]
+            batch["sequence"].append(info.get("publication_sequence_number"))
+            batch["source"].append(info.get("source_timestamp"))
+            batch["received"].append(info.get("received_timestamp"))
+            batch["size"].append(len(data))
+            batch["stamp"].append(stamp)
+
+    try:
+        for topic in params["topics"]:
+            cls, type_name, found = yield from _topic_class(graph, topic, params, wait_for_type=True)
+            arrived[topic] = {column: [] for column in columns}
+            subscriptions.append(graph.node.create_subscription(
+                cls, topic, lambda data, info, t=topic: record(t, data, info),
+                qos_profile(params.get("qos", {}), found), raw=True))
+            yield {"event": "subscribed", "topic": topic, "type": type_name}
+        while True:
+            time.sleep(period)
+            with lock:
+                batch = dict(arrived)
+                arrived.update({topic: {column: [] for column in columns} for topic in batch})
+            yield {"event": "batch", "topics": batch}
+    finally:
+        for subscription in subscriptions:
+            graph.node.destroy_subscription(subscription)
+
+
+def _wait(done: Callable[[], bool]) -> Iterator[dict[str, Any]]:
+    """Heartbeats until ``done()``."""
+    while not done():
+        yield {"event": "heartbeat"}
+
+
+def call(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+    """Call ``params["service"]`` (a ``type`` service) with ``request`` (base64 CDR): ``waiting`` while
+    no server is available, then ``request`` and ``response {data}`` per call; with ``rate`` (Hz) again
+    and again until closed."""
+    cls = service_class(params["type"])
+    request = deserialize_message(base64.b64decode(params["request"]), cls.Request)
+    client = graph.node.create_client(cls, params["service"])
+    try:
+        if not client.wait_for_service(timeout_sec=0.1):
+            yield {"event": "waiting"}
+            yield from _wait(lambda: client.wait_for_service(timeout_sec=HEARTBEAT_SECONDS))
+        period, due = 1.0 / params["rate"] if params.get("rate") else None, time.monotonic()
+        while True:
+            yield {"event": "request"}
+            future = client.call_async(request)
+            yield from _wait(lambda: _done(future))
+            yield {"event": "response", "data": base64.b64encode(serialize(future.result())).decode()}
+            if period is None:
+                return
+            due += period
+            while (remaining := due - time.monotonic()) > 0:
+                time.sleep(min(remaining, HEARTBEAT_SECONDS))
+                yield {"event": "heartbeat"}
+    finally:
+        graph.node.destroy_client(client)
+
+
+GOAL_STATUS = {0: "UNKNOWN", 1: "ACCEPTED", 2: "EXECUTING", 3: "CANCELING", 4: "SUCCEEDED", 5: "CANCELED",
+               6: "ABORTED"}
+
+
+def goal(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+    """Send ``params["goal"]`` (base64 CDR of a ``type`` action's Goal) to ``action``: ``waiting``
+    while no server is available, then ``accepted {goal_id}`` (or ``rejected``), ``feedback {data}``
+    (with ``feedback``), and ``result {data, status}``. Closed before the result, the goal is
+    canceled."""
+    from rclpy.action import ActionClient
+
+    cls = action_class(params["type"])
+    request = deserialize_message(base64.b64decode(params["goal"]), cls.Goal)
+    client = ActionClient(graph.node, cls, params["action"])
+    handle = None
+    try:
+        if not client.wait_for_server(timeout_sec=0.1):
+            yield {"event": "waiting"}
+            yield from _wait(lambda: client.wait_for_server(timeout_sec=HEARTBEAT_SECONDS))
+        feedback: queue.SimpleQueue = queue.SimpleQueue()
+        sent = client.send_goal_async(request, feedback_callback=feedback.put if params.get("feedback") else None)
+        yield from _wait(lambda: _done(sent))
+        handle = sent.result()
+        if not handle.accepted:
+            handle = None
+            yield {"event": "rejected"}
+            return
+        yield {"event": "accepted", "goal_id": bytes(handle.goal_id.uuid).hex()}
+        result = handle.get_result_async()
+        while True:
+            finished = _done(result)
+            while not feedback.empty():
+                message = feedback.get().feedback
+                yield {"event": "feedback", "data": base64.b64encode(serialize(message)).decode()}
+            if finished:
+                break
+            yield {"event": "heartbeat"}
+        outcome = result.result()
+        handle = None
+        yield {"event": "result", "data": base64.b64encode(serialize(outcome.result)).decode(),
+               "status": GOAL_STATUS.get(outcome.status, "UNKNOWN")}
+    finally:
+        if handle is not None:  # the client went away first: do not leave the goal running
+            canceled = threading.Event()
+            handle.cancel_goal_async().add_done_callback(lambda _: canceled.set())
+            canceled.wait(2.0)
+        client.destroy()
+
+
+def _done(future) -> bool:
+    """Whether ``future`` (completed by the Graph's executor thread) is done, waiting up to a
+    heartbeat for it."""
+    deadline = time.monotonic() + HEARTBEAT_SECONDS
+    while not future.done() and time.monotonic() < deadline:
+        time.sleep(0.005)
+    return future.done()
+
+
+STREAMS = {"echo": echo, "publish": publish, "stats": stats, "call": call, "goal": goal}
+
+
+def local_stream(method: str, params: dict[str, Any], node_name: str | None = None,
+                 **in_process: Any) -> Iterator[dict[str, Any]]:
+    """A stream without the daemon: its endpoint on a fresh participant of this process, on a node
+    named ``node_name`` (default: a hidden one)."""
+    from roc.ros.graph import Graph
+
+    graph = Graph(node_name)
+    try:
+        with contextlib.closing(STREAMS[method](graph, params, **in_process)) as events:
+            yield from events
+    finally:
+        graph.close()

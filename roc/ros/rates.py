@@ -1,0 +1,83 @@
+"""Rates, bandwidth and delays of a topic over a sliding window, from what roc.ros.dataplane's
+``stats`` stream reports per message (no rclpy here).
+
+The rate is the publisher's: publication sequence numbers over source timestamps, so messages the
+subscriber lost or received late do not change it (with ``wall_time``, reception timestamps).
+"""
+
+from __future__ import annotations
+
+import statistics
+from collections import deque
+from dataclasses import dataclass
+
+NS = 1e-9
+
+
+@dataclass
+class Sample:
+    sequence: int | None
+    source: int | None  # ns
+    received: int | None  # ns
+    size: int
+    stamp: int | None  # ns, the message's header stamp
+
+
+def samples(columns: dict[str, list]) -> list[Sample]:
+    """The samples of one topic's ``batch`` columns."""
+    return [Sample(*row) for row in zip(columns["sequence"], columns["source"], columns["received"],
+                                        columns["size"], columns["stamp"])]
+
+
+class Window:
+    """The last ``size`` samples of a topic and the messages lost among them."""
+
+    def __init__(self, size: int):
+        self.samples: deque[Sample] = deque(maxlen=size)
+        self.lost = 0
+
+    def add(self, new: list[Sample]) -> None:
+        for sample in new:
+            last = self.samples[-1] if self.samples else None
+            if last and last.sequence is not None and sample.sequence is not None and sample.sequence > last.sequence + 1:
+                self.lost += sample.sequence - last.sequence - 1
+            self.samples.append(sample)
+
+    def rate(self, wall_time: bool = False) -> dict | None:
+        """``{rate, min, max, std_dev, window}`` (seconds between messages), or None before two samples."""
+        timed = [(s.sequence, s.received if wall_time or s.source is None else s.source) for s in self.samples]
+        if len(timed) < 2 or timed[-1][1] == timed[0][1]:
+            return None
+        counted = all(sequence is not None for sequence, _ in timed)
+        messages = timed[-1][0] - timed[0][0] if counted else len(timed) - 1
+        if messages <= 0:  # several publishers: their sequence numbers interleave
+            messages = len(timed) - 1
+        deltas = [(b[1] - a[1]) * NS for a, b in zip(timed, timed[1:])]
+        return {"rate": messages / ((timed[-1][1] - timed[0][1]) * NS), "min": min(deltas), "max": max(deltas),
+                "std_dev": statistics.pstdev(deltas), "window": len(timed)}
+
+    def bandwidth(self) -> dict | None:
+        """``{bytes_per_second, messages, mean, min, max}`` (sizes in bytes), or None before two samples."""
+        times = [s.received for s in self.samples]
+        if len(times) < 2 or times[-1] == times[0]:
+            return None
+        sizes = [s.size for s in self.samples]
+        return {"bytes_per_second": sum(sizes) / ((times[-1] - times[0]) * NS), "messages": len(sizes),
+                "mean": statistics.fmean(sizes), "min": min(sizes), "max": max(sizes)}
+
+    def delay(self) -> dict | None:
+        """``{delay, min, max, std_dev, window}``: reception time minus header stamp (seconds)."""
+        delays = [(s.received - s.stamp) * NS for s in self.samples if s.stamp is not None and s.received]
+        if not delays:
+            return None
+        return {"delay": statistics.fmean(delays), "min": min(delays), "max": max(delays),
+                "std_dev": statistics.pstdev(delays), "window": len(delays)}
+
+
+def size_text(value: float) -> str:
+    """Bytes as ros2 topic bw prints them: ``282 B``, ``1.50 KB``, ``2.00 MB``."""
+    if value < 1000:
+        return f"{value:.0f} B"
+    if value < 1_000_000:
+        return f"{value / 1000:.2f} KB"
+    return f"{value / 1_000_000:.2f} MB"

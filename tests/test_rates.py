@@ -1,0 +1,71 @@
+"""Unit tests of topic hz/bw/delay's arithmetic (roc.ros.rates) and of reading a header stamp from CDR."""
+
+from __future__ import annotations
+
+import pytest
+
+from roc.ros.rates import Sample, Window, samples, size_text
+
+MS = 1_000_000
+
+
+def _sample(sequence: int, source_ms: float, received_ms: float | None = None, size: int = 10,
+            stamp_ms: float | None = None) -> Sample:
+    received = source_ms if received_ms is None else received_ms
+    return Sample(sequence, int(source_ms * MS), int(received * MS), size,
+                  None if stamp_ms is None else int(stamp_ms * MS))
+
+
+def test_rate_is_the_publishers_despite_losses_and_late_reception() -> None:
+    window = Window(100)
+    # 100 Hz publisher; messages 3 and 4 lost; reception jittery (a busy subscriber).
+    window.add([_sample(1, 0, 5), _sample(2, 10, 11), _sample(5, 40, 70), _sample(6, 50, 71)])
+    rate = window.rate()
+    assert rate["rate"] == pytest.approx(100.0)
+    assert (rate["min"], rate["max"], rate["window"]) == (pytest.approx(0.01), pytest.approx(0.03), 4)
+    assert window.lost == 2
+    assert window.rate(wall_time=True)["rate"] == pytest.approx(5 / 0.066)
+
+
+def test_window_keeps_the_last_messages_and_needs_two() -> None:
+    window = Window(3)
+    window.add([_sample(1, 0)])
+    assert window.rate() is None and window.bandwidth() is None
+    window.add([_sample(n, n * 100) for n in range(2, 7)])
+    assert [s.sequence for s in window.samples] == [4, 5, 6]
+    assert window.rate()["rate"] == pytest.approx(10.0)
+
+
+def test_interleaved_publishers_fall_back_to_counting() -> None:
+    window = Window(10)
+    window.add([_sample(5, 0), _sample(1, 50), _sample(6, 100), _sample(2, 150)])
+    assert window.rate()["rate"] == pytest.approx(3 / 0.15)
+
+
+def test_bandwidth_and_delay() -> None:
+    window = Window(10)
+    window.add([_sample(n, n * 100, size=size, stamp_ms=n * 100 - 2) for n, size in ((1, 100), (2, 300), (3, 200))])
+    bandwidth = window.bandwidth()
+    assert bandwidth == {"bytes_per_second": pytest.approx(600 / 0.2), "messages": 3, "mean": 200, "min": 100,
+                         "max": 300}
+    delay = window.delay()
+    assert (delay["delay"], delay["min"], delay["max"], delay["window"]) == (
+        pytest.approx(0.002), pytest.approx(0.002), pytest.approx(0.002), 3)
+
+
+def test_samples_from_batch_columns_and_sizes_as_ros2_prints_them() -> None:
+    columns = {"sequence": [1, 2], "source": [10, 20], "received": [11, 21], "size": [5, 6], "stamp": [None, 3]}
+    assert samples(columns) == [Sample(1, 10, 11, 5, None), Sample(2, 20, 21, 6, 3)]
+    assert [size_text(v) for v in (28, 999.4, 1500, 2_000_000)] == ["28 B", "999 B", "1.50 KB", "2.00 MB"]
+
+
+def test_header_stamp_is_read_from_cdr() -> None:
+    from rclpy.serialization import serialize_message
+    from std_msgs.msg import Header
+
+    from roc.ros.dataplane import header_stamp_ns
+
+    header = Header(frame_id="map")
+    header.stamp.sec, header.stamp.nanosec = 12, 345
+    assert header_stamp_ns(serialize_message(header)) == 12_000_000_345
+    assert header_stamp_ns(b"\x00\x01") is None
