@@ -1,11 +1,13 @@
 """The ``idl`` task of ``roc work build``: code generation for a package with protobuf sources.
 
 A package whose package.xml exports ``<roc_idl>DIR</roc_idl>`` gets, besides its ``build`` task, a task
-of kind ``idl`` that the build task waits for. It runs ``python -m roc.idl.codegen`` (a command of its
-own, so its output is in the task's log, ``log/<run>/<pkg>/idl/``, and Ctrl+C stops it), which writes the
-.msg files, ``roc_idl.cmake`` and protoc's Python modules into ``<build-base>/<pkg>/roc_idl``, rewriting
-only the files whose text changed. The build passes that directory to CMake (``-DROC_IDL_DIR``), and the
-package's fingerprint counts the files in it (roc.builder.uptodate).
+of kind ``idl`` (key ``idl:<pkg>``) that the build task waits for. It runs ``python -m roc.idl.codegen``
+(a command of its own, so its output is in the task's log, ``log/<run>/<pkg>/idl/``, and Ctrl+C stops
+it), which writes the .msg files, ``roc_idl.cmake`` and protoc's Python modules into
+``<build-base>/<pkg>/roc_idl``, rewriting only the files whose text changed (CMake then rebuilds only
+what depends on them). The build passes that directory to CMake (``-DROC_IDL_DIR``), and the package's
+fingerprint counts the files in it (roc.builder.uptodate), so a change of the generated files rebuilds
+the package and its dependents.
 
 The task is up to date when the .proto files, the code generator and the generated files are what its
 last successful run recorded in ``<build-base>/<pkg>/roc_idl_state.json``.
@@ -18,10 +20,16 @@ import hashlib
 import json
 import os
 import sys
+from importlib import metadata
 from pathlib import Path
 
-MARKER = "roc_idl"
-OUTPUT = "roc_idl"  # the output directory, in the package's build directory
+from roc.builder.environment import base_environment
+from roc.builder.fingerprint import FileStamps, changes, source_parts, source_stamps
+from roc.builder.state import read_record
+from roc.engine.process import TaskContext, TaskError
+from roc.fsutil import write_text_atomic
+
+MARKER = "roc_idl"  # the package.xml export, and the output directory in the package's build directory
 STATE_FILE = "roc_idl_state.json"
 
 
@@ -41,31 +49,32 @@ def proto_directory(source: Path) -> Path | None:
 
 def generated_directory(source: Path, build_dir: Path) -> Path | None:
     """Where the package's generated files are, when it has protobuf sources."""
-    return build_dir / OUTPUT if proto_directory(source) is not None else None
+    return build_dir / MARKER if proto_directory(source) is not None else None
 
 
 def cmake_arguments(build_dir: Path) -> list[str]:
     """What the package's CMake configure needs to find the generated files."""
-    return [f"-DROC_IDL_DIR={build_dir / OUTPUT}"]
+    return [f"-DROC_IDL_DIR={build_dir / MARKER}"]
 
 
 @functools.cache
 def generator_stamp() -> str:
-    """The code generator's identity: roc's IDL modules (a new roc generates anew)."""
+    """The code generator's identity: roc's IDL modules and protoc (a new roc or protoc generates anew)."""
     digest = hashlib.sha256()
     for path in sorted(Path(__file__).parent.glob("*.py")):
         digest.update(path.name.encode() + b"\0" + path.read_bytes())
+    for distribution in ("grpcio-tools", "protobuf"):
+        try:
+            digest.update(f"{distribution}=={metadata.version(distribution)}".encode())
+        except metadata.PackageNotFoundError:
+            pass
     return digest.hexdigest()
 
 
 def read_state(build_dir: Path) -> dict:
-    """The last successful generation's record; {} when there is none or it is damaged."""
-    try:
-        state = json.loads((build_dir / STATE_FILE).read_text())
-    except (OSError, ValueError):
-        return {}
-    valid = isinstance(state, dict) and all(isinstance(state.get(k), dict) for k in ("inputs", "outputs"))
-    return state if valid else {}
+    """The last successful generation's record ({} when there is none; a damaged one is reported)."""
+    return read_record(build_dir / STATE_FILE, "damaged code-generation state; the package's code will be "
+                       "generated again", ("inputs", "outputs"))
 
 
 def stale_reasons(source: Path, build_dir: Path, forced: list[str] = ()) -> list[str]:
@@ -74,35 +83,30 @@ def stale_reasons(source: Path, build_dir: Path, forced: list[str] = ()) -> list
         return list(forced)
     stored = read_state(build_dir)
     if not stored:
-        return ["never generated"]
-    from roc.builder.fingerprint import changes, source_parts
-
-    before = {"sources": source_parts(stored["inputs"]), "generated": source_parts(stored["outputs"])}
-    now = {"sources": source_parts(_inputs(source, stored["inputs"])),
-           "generated": source_parts(_outputs(build_dir, stored["outputs"]))}
+        return ["its last code generation did not succeed" if (build_dir / MARKER).exists() else "never generated"]
+    inputs, outputs = stored.get("inputs", {}), stored.get("outputs", {})
+    before = {"sources": source_parts(inputs), "generated": source_parts(outputs)}
+    now = {"sources": source_parts(_inputs(source, inputs)), "generated": source_parts(_outputs(build_dir, outputs))}
     reasons = [reason.replace("generated files removed", "generated files missing") for reason in changes(before, now)]
     if stored.get("generator") != generator_stamp():
         reasons.append("code generator changed")
     return reasons
 
 
-def _inputs(source: Path, previous: dict) -> dict:
-    """The stamps of the package's .proto files, by path relative to the package."""
-    from roc.builder.fingerprint import source_stamps
-
+def _inputs(source: Path, previous: FileStamps) -> FileStamps:
+    """The stamps of the package's .proto files, by path relative to the package (as its reasons name
+    them: ``files changed: proto/robot/types.proto``)."""
     directory = proto_directory(source)
     if directory is None or not directory.is_dir():
         return {}
     prefix = os.path.relpath(directory, source)
-    old = {os.path.relpath(path, prefix): stamp for path, stamp in previous.items()}
+    stamps = source_stamps(directory, {os.path.relpath(path, prefix): stamp for path, stamp in previous.items()})
     return {os.path.normpath(os.path.join(prefix, path)): stamp
-            for path, stamp in source_stamps(directory, old).items() if path.endswith(".proto")}
+            for path, stamp in stamps.items() if path.endswith(".proto")}
 
 
-def _outputs(build_dir: Path, previous: dict) -> dict:
-    from roc.builder.fingerprint import source_stamps
-
-    out = build_dir / OUTPUT
+def _outputs(build_dir: Path, previous: FileStamps) -> FileStamps:
+    out = build_dir / MARKER
     return source_stamps(out, previous) if out.is_dir() else {}
 
 
@@ -119,20 +123,16 @@ class IdlGeneration:
 
     def command(self) -> list[str]:
         return [sys.executable, "-m", "roc.idl.codegen", self.name, str(proto_directory(self.source)),
-                str(self.build_dir / OUTPUT)]
+                str(self.build_dir / MARKER)]
 
-    def run(self, context) -> None:
-        from roc.builder.environment import base_environment
-        from roc.engine.process import TaskError
-        from roc.fsutil import write_text_atomic
-
+    def run(self, context: TaskContext) -> None:
         state = self.build_dir / STATE_FILE
         # Stamped before generating, so that an edit made during the run shows next time.
         inputs = _inputs(self.source, read_state(self.build_dir).get("inputs", {}))
         self.build_dir.mkdir(parents=True, exist_ok=True)
         state.unlink(missing_ok=True)  # until it succeeds, no old record may vouch for the outputs
         env = base_environment()
-        roc_root = str(Path(__file__).resolve().parents[2])  # the codegen of this very roc
+        roc_root = str(Path(__file__).resolve().parents[2])  # the code generator of this very roc
         env["PYTHONPATH"] = os.pathsep.join(p for p in (roc_root, env.get("PYTHONPATH")) if p)
         if context.run(self.command(), cwd=str(self.source), env=env) != 0:
             raise TaskError("code generation failed")
