@@ -82,3 +82,88 @@ def test_bad_proto_fails_with_its_file_and_line_and_is_never_up_to_date(tmp_path
     output = _run(generation)
     assert output.splitlines() == ["code generation failed", f'roc: error: {source / TYPES}:6:16: Expected ";".']
     assert generation.check() == ["its last code generation did not succeed"]
+
+
+CONVERT = """
+from robot import state_pb2
+from robot_proto_msgs.msg import State
+from robot_proto_msgs_protobuf import to_proto, to_ros  # installed with the package
+from robot_proto_tools import pose_fields  # the dependent package
+pb = state_pb2.State(mode=1, waypoint="dock", frames=[b"jpg"])
+pb.pose.x, pb.pose.theta = 1.0, 0.5
+pb.stamp.seconds = 42
+pb.sensors["lidar"] = 0.25
+ros = to_ros(pb, State)
+assert ros.goal_case == State.GOAL_WAYPOINT and ros.mode == State.MODE_DRIVING and ros.stamp.sec == 42
+assert to_proto(ros, state_pb2.State) == pb
+print(" ".join(pose_fields()))
+"""
+
+
+def _events(workspace: Path) -> list[dict]:
+    lines = (workspace / "log" / "latest_build" / "events.log").read_text().splitlines()
+    return [json.loads(line) for line in lines]
+
+
+def _reasons(events: list[dict]) -> dict[str, list[str]]:
+    """Why each task ran, by task key."""
+    return {(e["task"] if e["kind"] == "build" else f"{e['kind']}:{e['task']}"): e["reasons"]
+            for e in events if e["event"] == "TaskStarted"}
+
+
+def _build(workspace: Path, *args: str):
+    result = roc("work", "build", *args, cwd=workspace, timeout=900)
+    assert result.returncode == 0, result.stdout + result.stderr
+    return result
+
+
+@pytest.mark.slow
+def test_roc_work_build_runs_the_idl_task_first_and_again_only_when_needed(tmp_path):
+    workspace = tmp_path / "ws"
+    shutil.copytree(SOURCES, workspace / "src")
+    _build(workspace)
+    order = [(e["event"], e["kind"], e["task"]) for e in _events(workspace)
+             if e["event"] in ("TaskStarted", "TaskFinished")]
+    assert order == [("TaskStarted", "idl", "robot_proto_msgs"), ("TaskFinished", "idl", "robot_proto_msgs"),
+                     ("TaskStarted", "build", "robot_proto_msgs"), ("TaskFinished", "build", "robot_proto_msgs"),
+                     ("TaskStarted", "build", "robot_proto_tools"), ("TaskFinished", "build", "robot_proto_tools")]
+    assert _reasons(_events(workspace))["idl:robot_proto_msgs"] == ["never generated"]
+    idl_log = workspace / "log" / "latest_build" / "robot_proto_msgs" / "idl" / "command.log"
+    assert "-m roc.idl.codegen robot_proto_msgs" in idl_log.read_text()
+    (tmp_path / "convert.py").write_text(CONVERT)
+    run = in_sourced_shell(workspace, f"python {tmp_path / 'convert.py'}")
+    assert run.returncode == 0 and run.stdout.strip() == "x y theta", run.stdout + run.stderr
+
+    # nothing changed: every task cached, no tool runs
+    again = _build(workspace)
+    assert _reasons(_events(workspace)) == {}
+    cached = [e for e in _events(workspace) if e["event"] == "TaskFinished" and e["cached"]]
+    assert len(cached) == 3 and "2 packages and 1 idl task up to date" in again.stdout
+
+    # a .proto edited: generated again, the package and its dependent built again, saying why
+    _edit(workspace / "src" / "robot_proto_msgs" / TYPES, "double theta = 3;", "double theta = 3;\n  string frame = 4;")
+    _build(workspace)
+    reasons = _reasons(_events(workspace))
+    assert reasons["idl:robot_proto_msgs"] == [f"files changed: {TYPES}"]
+    assert reasons["robot_proto_msgs"][0] == f"files changed: {TYPES}"
+    assert reasons["robot_proto_tools"] == ["dependency changed: robot_proto_msgs"]
+    run = in_sourced_shell(workspace, f"python {tmp_path / 'convert.py'}")
+    assert run.stdout.strip() == "x y theta frame", run.stdout + run.stderr
+
+    # --force and --no-cache generate again (rewriting nothing that did not change)
+    state_msg = workspace / "build" / "robot_proto_msgs" / "roc_idl" / "msg" / "State.msg"
+    before = state_msg.stat().st_mtime_ns
+    for option in ("--force", "--no-cache"):
+        _build(workspace, option, "--packages-select", "robot_proto_msgs")
+        assert _reasons(_events(workspace)) == {"idl:robot_proto_msgs": [option], "robot_proto_msgs": [option]}
+    assert state_msg.stat().st_mtime_ns == before
+
+    # a bad .proto: the build fails with the file and line, no traceback, the idl task's log kept
+    _edit(workspace / "src" / "robot_proto_msgs" / TYPES, "double y = 2;", "double y = 2 oops;")
+    failed = roc("work", "build", cwd=workspace, timeout=900)
+    output = failed.stdout + failed.stderr
+    assert failed.returncode == 1 and "Traceback" not in output, output
+    error = f'roc: error: {workspace / "src" / "robot_proto_msgs" / TYPES}:6:16: Expected ";".'
+    assert error in output.splitlines() and "1 idl task failed: idl:robot_proto_msgs" in output, output
+    assert error in (workspace / "log" / "latest_build" / "robot_proto_msgs" / "idl" / "stderr.log").read_text()
+    assert [e["kind"] for e in _events(workspace) if e["event"] == "TaskStarted"] == ["idl"]
