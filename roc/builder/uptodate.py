@@ -23,7 +23,7 @@ from roc.builder.fingerprint import (
 from roc.builder.layout import package_prefix
 from roc.builder.state import install_intact, read_state
 from roc.buildtypes.context import BuildOptions
-from roc.idl.task import generated_directory
+from roc.idl.task import generated_stamps
 from roc.workspace.load import Workspace
 from roc.workspace.package import Package
 
@@ -87,9 +87,9 @@ class Fingerprints:
             "dependencies": {n: self._fingerprint(n) for n in sorted(self.workspace.dependencies.recursive(package.name))},
             "underlay": {n: self._underlay(n) for n in sorted(package.direct_dependencies() - by_name.keys())},
         }
-        generated = generated_directory(source, self.options.build_base / package.name)
+        generated = generated_stamps(source, self.options.build_base / package.name)
         if generated is not None:  # written by the package's idl task, outside its source tree
-            parts["generated"] = source_parts(source_stamps(generated, {}) if generated.is_dir() else {})
+            parts["generated"] = source_parts(generated)
         fingerprint = combine(parts)
         self._now[package.name] = fingerprint
         return PackageState(fingerprint, parts, files, stored)

@@ -95,8 +95,12 @@ def generate(package: str, sources: Path, out: Path) -> list[str]:
 
 
 def main(argv: list[str]) -> int:
-    """``python -m roc.idl.codegen PACKAGE SOURCES OUT``: the step as a command, so roc work build runs it
-    like its other tools (its output in the package's log)."""
+    """``python -m roc.idl.codegen PACKAGE SOURCES OUT``: the step as a command, so that the ``idl`` task
+    of roc work build runs it like its other tools (its output in the task's log, Ctrl+C stops it), and a
+    package's CMakeLists.txt can run it when another tool builds the package."""
+    if len(argv) != 3:
+        print("usage: python -m roc.idl.codegen PACKAGE SOURCES OUT", file=sys.stderr)
+        return 2
     package, sources, out = argv
     try:
         for name in generate(package, Path(sources), Path(out)):

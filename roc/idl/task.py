@@ -47,9 +47,9 @@ def proto_directory(source: Path) -> Path | None:
     return source / (element.text or "proto").strip() if element is not None else None
 
 
-def generated_directory(source: Path, build_dir: Path) -> Path | None:
-    """Where the package's generated files are, when it has protobuf sources."""
-    return build_dir / MARKER if proto_directory(source) is not None else None
+def generated_stamps(source: Path, build_dir: Path) -> FileStamps | None:
+    """The stamps of the files the package's ``idl`` task generated; None when it has no protobuf sources."""
+    return _outputs(build_dir, {}) if proto_directory(source) is not None else None
 
 
 def cmake_arguments(build_dir: Path) -> list[str]:
