@@ -2,9 +2,9 @@
 
 A fingerprint covers the package's source tree (hashed file by file; a file whose size and mtime are
 unchanged keeps its previous hash, so a no-op check only stats files), the files its ``idl`` task
-generated outside that tree (roc.idl.task), the options that shape its
-build, the tools its build type runs and the underlays, and the fingerprints of its workspace
-dependencies, so that a change propagates to every package that depends on it.
+generated outside that tree (roc.idl.task), the options that shape its build, the tools its build type
+runs and the underlays, and the fingerprints of its workspace dependencies, so that a change propagates
+to every package that depends on it.
 
 The parts are kept with the fingerprint of the last successful build, so that ``changes`` can say why
 a package is not up to date.
