@@ -73,7 +73,7 @@ class _PackageBuild:
         self.prefix = package_prefix(options.install_base, package.name, options.merge_install)
         self.jobserver, self.fingerprints = jobserver, fingerprints
         self.state: PackageState | None = None
-        self.cmake_args: list[str] = []  # from the package's other tasks (where the idl task wrote)
+        self.cmake_args: list[str] = []  # roc's own CMake arguments (where the package's idl task writes)
 
     def check(self) -> list[str]:
         if not self.options.use_state:
