@@ -167,3 +167,5 @@ def test_roc_work_build_runs_the_idl_task_first_and_again_only_when_needed(tmp_p
     assert error in output.splitlines() and "1 idl task failed: idl:robot_proto_msgs" in output, output
     assert error in (workspace / "log" / "latest_build" / "robot_proto_msgs" / "idl" / "stderr.log").read_text()
     assert [e["kind"] for e in _events(workspace) if e["event"] == "TaskStarted"] == ["idl"]
+    # so the package's build did not succeed (--packages-select-build-failed picks it)
+    assert (workspace / "build" / "robot_proto_msgs" / "colcon_build.rc").read_text() == "1\n"
