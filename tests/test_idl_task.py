@@ -66,6 +66,16 @@ def test_check_says_why_and_run_rewrites_only_what_changed(tmp_path):
     assert IdlGeneration("robot_proto_msgs", source, build_dir, ["--force"], True).check() == ["--force"]
 
 
+def test_damaged_state_is_reported_and_generates_again(tmp_path, capsys):
+    source, build_dir = tmp_path / "src", tmp_path / "build"
+    shutil.copytree(PACKAGE, source)
+    generation = IdlGeneration("robot_proto_msgs", source, build_dir, forced=[], record=True)
+    _run(generation)
+    (build_dir / STATE_FILE).write_text('{"inputs": [')
+    assert generation.check() == ["its last code generation did not succeed"]
+    assert f"{build_dir / STATE_FILE}: damaged code-generation state" in capsys.readouterr().err
+
+
 def test_no_cache_generates_without_recording(tmp_path):
     source, build_dir = tmp_path / "src", tmp_path / "build"
     shutil.copytree(PACKAGE, source)

@@ -77,7 +77,7 @@ def read_state(build_dir: Path) -> dict:
                        "generated again", ("inputs", "outputs"))
 
 
-def stale_reasons(source: Path, build_dir: Path, forced: list[str] = ()) -> list[str]:
+def stale_reasons(source: Path, build_dir: Path, forced: list[str]) -> list[str]:
     """Why the generated files must be made again (empty: up to date)."""
     if forced:
         return list(forced)
