@@ -195,3 +195,11 @@ def test_result_store_writes_colcons_test_results(tmp_path: Path) -> None:
     assert {p.relative_to(tmp_path).as_posix(): p.read_text() for p in tmp_path.glob("*/*")} == {
         "passed/colcon_test.rc": "0\n", "failing/colcon_test.rc": "test failures\n",
         "error/colcon_test.rc": "1\n", "stopped/colcon_test.rc": "SIGINT\n", "built/colcon_build.rc": "0\n"}
+
+
+def test_result_store_fails_the_build_of_a_package_whose_idl_task_failed(tmp_path: Path) -> None:
+    store = ResultStore(tmp_path, kind="build")
+    for event in (TaskFinished("ok", "idl"), TaskFailed("broken", "idl"), TaskAborted("stopped", "idl")):
+        store(event)
+    assert {p.relative_to(tmp_path).as_posix(): p.read_text() for p in tmp_path.glob("*/*")} == {
+        "broken/colcon_build.rc": "1\n", "stopped/colcon_build.rc": "SIGINT\n"}

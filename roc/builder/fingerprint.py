@@ -1,9 +1,10 @@
 """Content fingerprints: a package is up to date when nothing that shapes its build has changed.
 
 A fingerprint covers the package's source tree (hashed file by file; a file whose size and mtime are
-unchanged keeps its previous hash, so a no-op check only stats files), the options that shape its
-build, the tools its build type runs and the underlays, and the fingerprints of its workspace
-dependencies, so that a change propagates to every package that depends on it.
+unchanged keeps its previous hash, so a no-op check only stats files), the files its ``idl`` task
+generated outside that tree (roc.idl.task), the options that shape its build, the tools its build type
+runs and the underlays, and the fingerprints of its workspace dependencies, so that a change propagates
+to every package that depends on it.
 
 The parts are kept with the fingerprint of the last successful build, so that ``changes`` can say why
 a package is not up to date.
@@ -172,14 +173,15 @@ def _names(names: list[str], limit: int = 3) -> str:
 def changes(before: dict, now: dict) -> list[str]:
     """Why ``now``'s parts differ from ``before``'s, one short reason per kind of change."""
     reasons = []
-    old_files, new_files = before.get("sources", {}), now.get("sources", {})
-    for label, names in (
-        ("files added", [f for f in new_files if f not in old_files]),
-        ("files changed", [f for f in new_files if f in old_files and old_files[f] != new_files[f]]),
-        ("files removed", [f for f in old_files if f not in new_files]),
-    ):
-        if names:
-            reasons.append(f"{label}: {_names(sorted(names))}")
+    for part, what in (("sources", "files"), ("generated", "generated files")):
+        old_files, new_files = before.get(part, {}), now.get(part, {})
+        for label, names in (
+            (f"{what} added", [f for f in new_files if f not in old_files]),
+            (f"{what} changed", [f for f in new_files if f in old_files and old_files[f] != new_files[f]]),
+            (f"{what} removed", [f for f in old_files if f not in new_files]),
+        ):
+            if names:
+                reasons.append(f"{label}: {_names(sorted(names))}")
     for part, label in (("options", "option changed"), ("toolchain", "toolchain changed"),
                         ("dependencies", "dependency changed"), ("underlay", "underlay package changed")):
         old, new = before.get(part, {}), now.get(part, {})

@@ -1,4 +1,7 @@
-"""Turn the selected packages into engine tasks: environment, build type, install hooks."""
+"""Turn the selected packages into engine tasks: environment, build type, install hooks.
+
+Each selected package gets a ``build`` task; a package with protobuf sources also gets an ``idl`` task
+(its code generation, roc.idl.task), which its build task waits for."""
 
 from __future__ import annotations
 
@@ -17,10 +20,13 @@ from roc.builder.uptodate import (
 )
 from roc.buildtypes import build_function
 from roc.buildtypes.context import BuildOptions, PackageJob
+from roc.engine.events import task_key
 from roc.engine.jobserver import Jobserver
 from roc.engine.process import TaskContext
 from roc.engine.ready import Task
 from roc.fsutil import write_text_atomic
+from roc.idl.task import IdlGeneration, proto_directory
+from roc.idl.task import cmake_arguments as idl_cmake_arguments
 from roc.workspace.load import Workspace
 from roc.workspace.package import Package
 
@@ -28,17 +34,28 @@ from roc.workspace.package import Package
 def plan_build(
     workspace: Workspace, options: BuildOptions, jobserver: Jobserver | None, weights: dict[str, float]
 ) -> list[Task]:
-    """One ``build`` task per selected package. Whether a package is up to date is checked when its
-    task is dispatched (its dependencies built by then)."""
+    """One ``build`` task per selected package, and one ``idl`` task before it for a package with
+    protobuf sources. Whether a task is up to date is checked when it is dispatched (what it waits for
+    done by then)."""
     selected = workspace.selected
     fingerprints = Fingerprints(workspace, options)
+    forced = [flag for flag in forced_reasons(options) if flag in ("--no-cache", "--force")]
     tasks = []
     for package in workspace.selected_in_order():
         dependencies = workspace.dependencies.in_order(package.name)
         build = _PackageBuild(package, workspace.root, dependencies, options, jobserver, fingerprints)
+        waits_for = {n for n in dependencies if n in selected}
+        if proto_directory(build.source) is not None:
+            idl = IdlGeneration(package.name, build.source, options.build_base / package.name, forced,
+                                record=options.use_state)
+            key = task_key("idl", package.name)
+            tasks.append(Task(name=package.name, dependencies=set(), action=idl.run, kind="idl",
+                              weight=weights.get(key, 1.0), check=idl.check))
+            waits_for.add(key)
+            build.cmake_args = idl_cmake_arguments(options.build_base / package.name)
         tasks.append(Task(
             name=package.name,
-            dependencies={n for n in dependencies if n in selected},
+            dependencies=waits_for,
             action=build.run,
             weight=weights.get(package.name, 1.0),
             check=build.check,
@@ -56,6 +73,7 @@ class _PackageBuild:
         self.prefix = package_prefix(options.install_base, package.name, options.merge_install)
         self.jobserver, self.fingerprints = jobserver, fingerprints
         self.state: PackageState | None = None
+        self.cmake_args: list[str] = []  # roc's own CMake arguments (where the package's idl task writes)
 
     def check(self) -> list[str]:
         if not self.options.use_state:
@@ -67,7 +85,7 @@ class _PackageBuild:
         package, options = self.package, self.options
         env = build_environment(package, self.dependencies, options)
         job = PackageJob(package=package, source=self.source, build_dir=options.build_base / package.name,
-                         prefix=self.prefix, env=env)
+                         prefix=self.prefix, env=env, cmake_args=self.cmake_args)
         if self.jobserver is not None:
             job.make_flags = self.jobserver.makeflags(env.get("MAKEFLAGS", ""))
             job.pass_fds = self.jobserver.fds

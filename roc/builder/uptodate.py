@@ -23,6 +23,7 @@ from roc.builder.fingerprint import (
 from roc.builder.layout import package_prefix
 from roc.builder.state import install_intact, read_state
 from roc.buildtypes.context import BuildOptions
+from roc.idl.task import generated_stamps
 from roc.workspace.load import Workspace
 from roc.workspace.package import Package
 
@@ -76,7 +77,8 @@ class Fingerprints:
         """The package's state now; its dependencies must have been computed (or built) first."""
         by_name = self.workspace.by_name
         stored = read_state(self.options.build_base / package.name)
-        files = source_stamps((self.workspace.root / package.path).resolve(), stored.get("files", {}))
+        source = (self.workspace.root / package.path).resolve()
+        files = source_stamps(source, stored.get("files", {}))
         tools = build_tools(package.build_type, self.environment, self.options.cmake_args_for(package.name))
         parts = {
             "sources": source_parts(files),
@@ -85,6 +87,9 @@ class Fingerprints:
             "dependencies": {n: self._fingerprint(n) for n in sorted(self.workspace.dependencies.recursive(package.name))},
             "underlay": {n: self._underlay(n) for n in sorted(package.direct_dependencies() - by_name.keys())},
         }
+        generated = generated_stamps(source, self.options.build_base / package.name)
+        if generated is not None:  # written by the package's idl task, outside its source tree
+            parts["generated"] = source_parts(generated)
         fingerprint = combine(parts)
         self._now[package.name] = fingerprint
         return PackageState(fingerprint, parts, files, stored)

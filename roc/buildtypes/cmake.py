@@ -22,7 +22,7 @@ def cmake_arguments(job: PackageJob, options: BuildOptions) -> list[str]:
         args += options.ament_cmake_args_for(job.package.name)
         if options.symlink_install:
             args.append("-DAMENT_CMAKE_SYMLINK_INSTALL=1")
-    return args
+    return args + job.cmake_args
 
 
 def _cache_value(build_dir: Path, key: str) -> str | None:
@@ -103,12 +103,6 @@ def build_cmake(context: TaskContext, job: PackageJob, options: BuildOptions) ->
     build_dir = job.build_dir
     build_dir.mkdir(parents=True, exist_ok=True)
     args = cmake_arguments(job, options)
-    from roc.idl.buildstep import command as idl_step
-
-    idl = idl_step(job.package.name, job.source, build_dir)
-    if idl is not None:  # protobuf sources: .msg files generated into the build directory first
-        _check(context, job, idl[0], "code generation (roc idl)")
-        args.append(idl[1])
     last_args = build_dir / "cmake_args.last"
     recorded = repr(args) if args else "None"
     if options.cmake_clean_cache:

@@ -54,3 +54,4 @@ class PackageJob:
     env: dict[str, str] = field(default_factory=dict)
     make_flags: str = ""  # MAKEFLAGS for make-based builds (jobserver client flags)
     pass_fds: tuple[int, ...] = ()
+    cmake_args: list[str] = field(default_factory=list)  # roc's own, after the user's (the idl task's ROC_IDL_DIR)

@@ -73,7 +73,7 @@ def output_handlers(args: argparse.Namespace, switches: dict[str, bool], root: P
         handlers.append(LogHandler(log_dir, events=switches["event_log"], commands=switches["log_command"],
                                    kind=verb))
     if switches["store_result"]:
-        handlers.append(ResultStore(build_base))
+        handlers.append(ResultStore(build_base, kind=verb))
     if args.output == "json":
         handlers.append(JsonEventsHandler(sys.stdout))
         return handlers

@@ -119,10 +119,13 @@ TEST_FAILURES_RESULT = "test failures"
 
 class ResultStore:
     """Writes each package's result where --packages-select-build-failed (or -test-failures) looks:
-    0, 1, SIGINT, or "test failures" for a task that finished after a ``TestFailures`` event."""
+    0, 1, SIGINT, or "test failures" for a task that finished after a ``TestFailures`` event. A task of a
+    kind that keeps no result (``idl:pkg``) that fails or is aborted sets the result of the run's own
+    ``kind`` for its package: that package's build did not succeed either."""
 
-    def __init__(self, build_base: Path):
+    def __init__(self, build_base: Path, kind: str = "build"):
         self.build_base = build_base
+        self.kind = kind
         self.test_failures: set[str] = set()  # task keys
 
     def __call__(self, event: Event) -> None:
@@ -131,11 +134,12 @@ class ResultStore:
             return
         results = {TaskFinished: "0", TaskFailed: "1", TaskAborted: INTERRUPTED_RESULT}
         result = results.get(type(event))
-        if result is None or event.kind not in RESULT_FILES:
+        kind = event.kind if event.kind in RESULT_FILES or result == "0" else self.kind
+        if result is None or kind not in RESULT_FILES:
             return
         if result == "0" and event.key in self.test_failures:
             result = TEST_FAILURES_RESULT
-        write_text_atomic(self.build_base / event.task / RESULT_FILES[event.kind], result + "\n")
+        write_text_atomic(self.build_base / event.task / RESULT_FILES[kind], result + "\n")
 
 
 class JsonEventsHandler:
