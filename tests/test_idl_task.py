@@ -150,8 +150,15 @@ def test_roc_work_build_runs_the_idl_task_first_and_again_only_when_needed(tmp_p
     cached = [e for e in _events(workspace) if e["event"] == "TaskFinished" and e["cached"]]
     assert len(cached) == 3 and "2 packages and 1 idl task up to date" in again.stdout
 
-    # a .proto edited: generated again, the package and its dependent built again, saying why
+    # a .proto edited: --explain says what would run and why; then generated again, the package and its
+    # dependent built again, saying why
     _edit(workspace / "src" / "robot_proto_msgs" / TYPES, "double theta = 3;", "double theta = 3;\n  string frame = 4;")
+    explained = roc("work", "build", "--explain", cwd=workspace)
+    assert explained.stdout.splitlines()[:2] == [f"idl:robot_proto_msgs: files changed: {TYPES}",
+                                                 f"robot_proto_msgs: files changed: {TYPES}"], explained.stdout
+    as_json = json.loads(roc("work", "build", "--explain", "--output", "json", cwd=workspace).stdout)
+    assert [(e["kind"], e["package"]) for e in as_json] == [("idl", "robot_proto_msgs"), ("build", "robot_proto_msgs"),
+                                                            ("build", "robot_proto_tools")]
     _build(workspace)
     reasons = _reasons(_events(workspace))
     assert reasons["idl:robot_proto_msgs"] == [f"files changed: {TYPES}"]

@@ -16,6 +16,7 @@ from roc.builder.uptodate import (
     Fingerprints,
     PackageState,
     forced_reasons,
+    generation_forced,
     stale_reasons,
 )
 from roc.buildtypes import build_function
@@ -39,7 +40,7 @@ def plan_build(
     done by then)."""
     selected = workspace.selected
     fingerprints = Fingerprints(workspace, options)
-    forced = [flag for flag in forced_reasons(options) if flag in ("--no-cache", "--force")]
+    forced = generation_forced(options)
     tasks = []
     for package in workspace.selected_in_order():
         dependencies = workspace.dependencies.in_order(package.name)

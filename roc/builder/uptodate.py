@@ -123,10 +123,26 @@ def stale_reasons(package: Package, state: PackageState, options: BuildOptions) 
     return []
 
 
-def explain(workspace: Workspace, options: BuildOptions) -> list[tuple[str, list[str]]]:
-    """Each selected package, in build order, with why it would be built (empty: up to date)."""
+def generation_forced(options: BuildOptions) -> list[str]:
+    """The options that also make an ``idl`` task generate again whatever its state."""
+    return [flag for flag in forced_reasons(options) if flag in ("--no-cache", "--force")]
+
+
+def explain(workspace: Workspace, options: BuildOptions) -> list[tuple[str, str, list[str]]]:
+    """Each task of the build, in build order, as (kind, package, why it would run; empty: up to date):
+    a package's ``idl`` task (protobuf sources) before its ``build`` task."""
+    from roc.idl.task import proto_directory
+    from roc.idl.task import stale_reasons as generation_reasons
+
     fingerprints = Fingerprints(workspace, options)
-    return [(p.name, stale_reasons(p, fingerprints.compute(p), options)) for p in workspace.selected_in_order()]
+    explained = []
+    for package in workspace.selected_in_order():
+        source = (workspace.root / package.path).resolve()
+        if proto_directory(source) is not None:
+            explained.append(("idl", package.name, generation_reasons(source, options.build_base / package.name,
+                                                                      generation_forced(options))))
+        explained.append(("build", package.name, stale_reasons(package, fingerprints.compute(package), options)))
+    return explained
 
 
 def fingerprint_packages(workspace: Workspace, options: BuildOptions) -> dict[str, PackageState]:

@@ -104,11 +104,13 @@ def _explain(args: argparse.Namespace, workspace, options) -> int:
     from roc.builder.uptodate import explain
     from roc.render import print_json, print_lines
 
+    from roc.engine.events import task_key
+
     explained = explain(workspace, options)
     if args.output == "json":
-        print_json([{"package": name, "reasons": reasons} for name, reasons in explained])
+        print_json([{"package": name, "kind": kind, "reasons": reasons} for kind, name, reasons in explained])
     else:
-        print_lines([f"{name}: {'; '.join(reasons) or 'up to date'}" for name, reasons in explained])
+        print_lines([f"{task_key(kind, name)}: {'; '.join(reasons) or 'up to date'}" for kind, name, reasons in explained])
     return 0
 
 
