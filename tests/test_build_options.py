@@ -34,7 +34,8 @@ def _commands(ws: Path, package: str) -> str:
 
 def test_configure_runs_only_when_needed(ws):
     assert roc("work", "build", cwd=ws).returncode == 0
-    assert "Invoking command in" in _commands(ws, "alpha") and "cmake " in _commands(ws, "alpha")
+    assert (f"Invoking command in '{ws}/build/alpha': cmake {ws}/src/alpha -DCMAKE_INSTALL_PREFIX={ws}/install/alpha\n"
+            in _commands(ws, "alpha")), _commands(ws, "alpha")  # configured, as colcon logs it
     assert (ws / "build" / "alpha" / "cmake_args.last").read_text() == "None"
     assert roc("work", "build", "--force", cwd=ws).returncode == 0  # --force: build even if up to date
     assert "-DCMAKE_INSTALL_PREFIX" not in _commands(ws, "alpha")  # but no configure: nothing changed
