@@ -136,3 +136,47 @@ def test_concurrent_builds_wait_for_each_other(tmp_path):
     assert "waiting for it to finish" in second.stderr
     assert "2 packages up to date" in second.stdout  # the second found the first's results
     assert "core says 42" in in_sourced_shell(ws, "install/app/lib/app/app").stdout
+
+
+def _reasons(ws) -> dict[str, list[str]]:
+    return {e["task"]: e["reasons"] for e in _events(ws) if e["event"] == "TaskStarted"}
+
+
+def test_editor_droppings_are_not_source_changes(built):
+    """Issue 17.3: swap, backup and lock files of editors rebuild nothing; another new file does."""
+    sources = built / "src" / "core" / "src"
+    droppings = [sources / ".core.cpp.swp", sources / "core.cpp~", sources / ".#core.cpp", sources / "#core.cpp#",
+                 sources / "4913", sources / ".DS_Store"]
+    try:
+        for dropping in droppings:
+            dropping.write_text("x")
+        assert roc("work", "build", cwd=built).returncode == 0
+        assert _built(built) == set()
+        (sources / "notes.txt").write_text("x")  # anything a build could read still counts
+        assert roc("work", "build", cwd=built).returncode == 0
+        assert _reasons(built)["core"] == ["files added: src/notes.txt"]
+        assert _built(built) == {"core", "app", "pyp"}
+    finally:
+        for dropping in [*droppings, sources / "notes.txt"]:
+            dropping.unlink(missing_ok=True)
+    assert roc("work", "build", cwd=built).returncode == 0  # (notes.txt removed: built once more)
+
+
+def test_only_the_tools_a_build_uses_count(built, tmp_path):
+    """Issue 17.2: an unused ninja on PATH rebuilds nothing; another C++ compiler rebuilds the C++ packages."""
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    (bin_dir / "ninja").write_text("#!/bin/sh\nexit 1\n")
+    (bin_dir / "ninja").chmod(0o755)
+    env = ros_env(PATH=f"{bin_dir}:{ros_env()['PATH']}")
+    assert roc("work", "build", cwd=built, env=env).returncode == 0
+    assert _built(built) == set()  # Unix Makefiles: ninja is not a tool of these builds
+    compiler = bin_dir / "c++"
+    compiler.write_text(f"#!/bin/sh\nexec {shutil.which('c++')} \"$@\"\n")
+    compiler.chmod(0o755)
+    changed = roc("work", "build", cwd=built, env=ros_env(PATH=f"{bin_dir}:{ros_env()['PATH']}"))
+    assert changed.returncode == 0, changed.stdout + changed.stderr
+    reasons = _reasons(built)
+    assert any(r.startswith("toolchain changed: ") and "tool c++" in r for r in reasons["core"]), reasons
+    assert "pyp" not in reasons or not any("c++" in r for r in reasons["pyp"])  # a Python package uses no compiler
+    assert roc("work", "build", cwd=built).returncode == 0  # back to the usual compiler
