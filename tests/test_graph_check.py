@@ -78,6 +78,7 @@ def graph(tmp_path_factory):
     stop_all(processes)
 
 
+@pytest.mark.slow
 def test_a_system_that_meets_every_expectation(graph, tmp_path: Path) -> None:
     from junitparser import JUnitXml
 
@@ -93,6 +94,7 @@ def test_a_system_that_meets_every_expectation(graph, tmp_path: Path) -> None:
                                                    "/motor/enable", "/talker"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("violation", list(VIOLATIONS), ids=[v.split("\n")[-1][:30] for v in VIOLATIONS])
 def test_each_kind_of_violation_is_reported_precisely(graph, tmp_path: Path, violation: str) -> None:
     check = tmp_path / "expected.toml"
@@ -103,6 +105,7 @@ def test_each_kind_of_violation_is_reported_precisely(graph, tmp_path: Path, vio
     assert "1 probe failed" in result.stdout
 
 
+@pytest.mark.slow
 def test_json_events_carry_each_probes_verdict_without_a_daemon(graph, tmp_path: Path) -> None:
     check = tmp_path / "expected.toml"
     check.write_text('[check]\nnodes = ["/talker", "/ghost"]\n')
@@ -114,6 +117,7 @@ def test_json_events_carry_each_probes_verdict_without_a_daemon(graph, tmp_path:
     assert verdicts["node /ghost"][0] == "fail" and verdicts["node /ghost"][1].startswith("no node /ghost (nodes: ")
 
 
+@pytest.mark.slow
 def test_a_snapshot_checks_green_against_its_system(graph, tmp_path: Path) -> None:
     snapshot = roc("graph", "snapshot", "--rate-window", "2", env=graph)
     assert snapshot.returncode == 0, snapshot.stderr
@@ -153,6 +157,7 @@ def _free_port() -> int:
         return probe.getsockname()[1]
 
 
+@pytest.mark.slow
 def test_watch_serves_prometheus_metrics_until_ctrl_c(graph, tmp_path: Path) -> None:
     import signal
     import subprocess
