@@ -101,7 +101,7 @@ def execute(
                 raise
             except Exception as error:  # noqa: BLE001 - one broken output must not break the build
                 handlers.remove(handler)
-                name = getattr(handler, "name", type(handler).__name__)
+                name = getattr(handler, "name", getattr(handler, "__name__", type(handler).__name__))
                 warn(f"event handler '{name}' failed and was disabled: {type(error).__name__}: {error}")
 
     def stop_running() -> None:
