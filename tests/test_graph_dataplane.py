@@ -58,6 +58,8 @@ def test_echo_adapts_to_a_transient_local_publisher_and_prints_json(graph) -> No
     assert line["info"]["publication_sequence_number"] == 1
     filtered = roc("topic", "echo", "/chatter", "--once", "--filter", "m.data == 'hello'", "--csv", env=env)
     assert (filtered.returncode, filtered.stdout) == (0, "hello\n")
+    with_info = roc("topic", "echo", "/latched", "--once", "--csv", "-i", env=env).stdout.strip().split(",")
+    assert with_info[2:] == ["1", "None", "kept"] and int(with_info[1]) >= int(with_info[0]) > 0
 
 
 def test_echo_follows_a_best_effort_publisher_unless_told_otherwise(graph) -> None:

@@ -17,6 +17,7 @@ DEFAULT_TRUNCATE_LENGTH = 128
 # ros2 subscribes with the sensor_data depth, 5: a burst larger than that is lost while the terminal
 # catches up. roc keeps the last 1000 (--qos-depth sets another).
 DEFAULT_DEPTH = 1000
+INFO_FIELDS = ("source_timestamp", "received_timestamp", "publication_sequence_number", "reception_sequence_number")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -120,6 +121,8 @@ def _message_text(event: dict, type_name: str, args: argparse.Namespace, accept,
         return json_line({"topic": args.topic_name, "type": type_name, "message": data, "lost": event["lost"],
                           **({"info": event["info"]} if args.include_message_info else {})})
     text = echo_text(value, csv=args.csv, flow_style=args.flow_style, **options)
+    if args.include_message_info and args.csv:  # the info fields first, as ros2 prepends them
+        return ",".join(str(event["info"].get(key)) for key in INFO_FIELDS) + "," + text
     if args.include_message_info:
         info = "".join(f"{key}: {value}\n" for key, value in event["info"].items())
         return f"---Got new message, message info:---\n{info}{text}"
