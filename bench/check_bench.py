@@ -27,8 +27,8 @@ from graph_bench import (  # noqa: E402
     graph_env,
     install_oracle,
     start_nodes,
-    stop_all,
-    stop_daemon,
+    start_daemons,
+    stop_everything,
     tool,
     tool_env,
 )
@@ -94,9 +94,7 @@ def main() -> int:
     processes = start_nodes([*DEMO_GRAPH, [RATED[0]]], env)
     check = check_file(work)
     try:
-        for name in ("roc", "ros2"):
-            subprocess.run([tool(name), "daemon", "start"], env=env, capture_output=True, timeout=60)
-        time.sleep(4)
+        start_daemons(env)
         times: dict[str, list[float]] = {"roc": [], "ros2": []}
         failed = {"roc": 0, "ros2": 0}
         for _ in range(options.runs):
@@ -110,9 +108,7 @@ def main() -> int:
         print(f"20 probes: roc graph check {roc_time:.2f} s, sequential ros2 CLI {ros2_time:.2f} s, "
               f"roc/ros2 {roc_time / ros2_time:.2f} (failed runs: roc {failed['roc']}, ros2 commands {failed['ros2']})")
     finally:
-        stop_daemon(env)
-        subprocess.run([tool("ros2"), "daemon", "stop"], env=env, capture_output=True, timeout=60)
-        stop_all(processes)
+        stop_everything(env, processes)
     return 0
 
 

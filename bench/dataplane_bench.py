@@ -31,8 +31,8 @@ from graph_bench import (  # noqa: E402
     graph_env,
     install_oracle,
     start_nodes,
-    stop_all,
-    stop_daemon,
+    start_daemons,
+    stop_everything,
     timed,
     tool,
     tool_env,
@@ -100,9 +100,7 @@ def main() -> int:
     env["ROS_DOMAIN_ID"] = "91"
     processes = start_nodes(GRAPH, env)
     try:
-        for name in ("roc", "ros2"):
-            subprocess.run([tool(name), "daemon", "start"], env=env, capture_output=True, timeout=60)
-        time.sleep(4)
+        start_daemons(env)
         print(f"{'command':75} {'roc s':>7} {'ros2 s':>7} {'roc/ros2':>8}  failed runs roc, ros2")
         for command in COMMANDS:
             times: dict[str, list[float]] = {"roc": [], "ros2": []}
@@ -127,9 +125,7 @@ def main() -> int:
             print(f"  received: rclpy subscriber {row['rclpy subscriber']}, roc echo {row['roc echo']} "
                   f"(reported lost {row['roc echo lost']}), ros2 echo {row['ros2 echo']}")
     finally:
-        stop_daemon(env)
-        subprocess.run([tool("ros2"), "daemon", "stop"], env=env, capture_output=True, timeout=60)
-        stop_all(processes)
+        stop_everything(env, processes)
     return 0
 
 

@@ -59,6 +59,19 @@ def timed(name: str, args: tuple[str, ...], env: dict[str, str], boot: bool = Tr
     return time.perf_counter() - start, done.stdout, done.returncode
 
 
+def start_daemons(env: dict[str, str]) -> None:
+    """Both tools' daemons, started and given a discovery period."""
+    for name in ("roc", "ros2"):
+        subprocess.run([tool(name), "daemon", "start"], env=env, capture_output=True, timeout=60)
+    time.sleep(4)
+
+
+def stop_everything(env: dict[str, str], processes: list) -> None:
+    """Both daemons and the graph's processes."""
+    stop_daemon(env)
+    stop_all(processes)
+
+
 def compare(env: dict[str, str], runs: int, extra: tuple[str, ...], boot: bool) -> list[tuple]:
     """(command, roc median, ros2 median, failed runs of roc, of ros2) per command."""
     rows = []
@@ -89,9 +102,7 @@ def main() -> int:
     env["ROS_DOMAIN_ID"] = "90"
     processes = start_nodes(DEMO_GRAPH, env)
     try:
-        for name in ("roc", "ros2"):
-            subprocess.run([tool(name), "daemon", "start"], env=env, capture_output=True, timeout=60)
-        time.sleep(4)
+        start_daemons(env)
         for name in ("roc", "ros2"):  # warm-up
             timed(name, ("topic", "list"), env)
         print(f"{'command':50} {'roc s':>7} {'ros2 s':>7} {'roc/ros2':>8}  failed runs roc, ros2")
@@ -107,9 +118,7 @@ def main() -> int:
                 complete += out.splitlines() == NODES
             print(f"{name} node list --no-daemon complete in {complete} of {options.completeness_runs} runs")
     finally:
-        stop_daemon(env)
-        subprocess.run([tool("ros2"), "daemon", "stop"], env=env, capture_output=True, timeout=60)
-        stop_all(processes)
+        stop_everything(env, processes)
     return 0
 
 

@@ -48,7 +48,8 @@ def tf_publishers(use_daemon: bool) -> dict[str, list[str]]:
     return found
 
 
-def run(args: argparse.Namespace) -> int:
+def heard_frames(args: argparse.Namespace) -> list[dict]:
+    """The rows of every frame heard in ``args.duration`` seconds (frame list, frame tree)."""
     from roc.frames.listen import Listener
 
     listener = Listener(use_daemon=not args.no_daemon)
@@ -56,7 +57,11 @@ def run(args: argparse.Namespace) -> int:
         listener.listen(seconds=args.duration)
     finally:
         listener.close()
-    rows = frame_rows(listener, tf_publishers(not args.no_daemon))
+    return frame_rows(listener, tf_publishers(not args.no_daemon))
+
+
+def run(args: argparse.Namespace) -> int:
+    rows = heard_frames(args)
     text = table_lines([[r["frame"], r["parent"] or "-", "-" if r["static"] is None else "static" if r["static"] else "dynamic",
                          f"{r['rate']:.1f} Hz" if r["rate"] else "-", f"{r['age']:.3f} s" if r["age"] is not None else "-",
                          ", ".join(r["publishers"]) or "-"] for r in rows],

@@ -9,7 +9,7 @@ import subprocess
 from pathlib import Path
 
 from roc.cli.options import add_discovery_arguments
-from roc.commands.frame_list import frame_rows, tf_publishers
+from roc.commands.frame_list import heard_frames
 from roc.errors import RocError, UsageError
 from roc.fsutil import write_text_atomic
 from roc.render import print_lines
@@ -76,17 +76,10 @@ def write_picture(path: Path, dot: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from roc.frames.listen import Listener
-
     suffix = args.output.suffix.lower() if args.output else ""
     if args.output and suffix not in (".dot", ".gv", *PICTURES):
         raise UsageError(f"--output {args.output}: use a .dot, .gv, .svg, .png or .pdf file name")
-    listener = Listener(use_daemon=not args.no_daemon)
-    try:
-        listener.listen(seconds=args.duration)
-    finally:
-        listener.close()
-    rows = frame_rows(listener, tf_publishers(not args.no_daemon))
+    rows = heard_frames(args)
     if args.output is None:
         print_lines(tree_lines(rows) or ["no tf frames heard"])
     elif suffix in PICTURES:
