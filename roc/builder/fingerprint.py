@@ -31,7 +31,7 @@ TOOLCHAIN_VARIABLES = ("CC", "CXX", "CFLAGS", "CXXFLAGS", "CPPFLAGS", "LDFLAGS",
                        "CMAKE_BUILD_TYPE", "ROS_DISTRO", "ROS_VERSION", "ROS_PYTHON_VERSION")
 PREFIX_VARIABLES = ("AMENT_PREFIX_PATH", "CMAKE_PREFIX_PATH", "COLCON_PREFIX_PATH")
 # Files an editor, a file manager or a merge tool leaves next to sources; no build reads them.
-EDITOR_DROPPINGS = re.compile(r"^(\..*\.sw[a-p]|.*~|\.#.*|#.*#|\.DS_Store|4913)$")
+EDITOR_DROPPINGS = re.compile(r"^(\..*\.sw[a-px]|.*~|\.#.*|#.*#|\.DS_Store|4913)$")
 
 FileStamps = dict[str, list]  # relative path -> [size, mtime_ns, sha256, executable]
 
