@@ -9,6 +9,8 @@ from pathlib import Path
 import pytest
 from build_helpers import BIN, roc, ros_env
 
+pytestmark = pytest.mark.slow  # real builds or a PowerShell parser: see README's quick loop
+
 SHOW_MAKEFLAGS = """cmake_minimum_required(VERSION 3.8)
 project({name} C)
 add_custom_target(show ALL COMMAND printenv MAKEFLAGS)

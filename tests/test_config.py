@@ -59,6 +59,7 @@ def test_package_settings_and_colcon_meta(ws):
     assert "beta" not in result.stdout
 
 
+@pytest.mark.slow
 def test_metas_and_user_metas(ws, tmp_path):
     home = tmp_path / "colcon-home"
     (home / "metadata").mkdir(parents=True)

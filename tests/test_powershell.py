@@ -17,6 +17,8 @@ from powershell_parse import PARSER, applied, check_package_scripts, parse, stat
 from roc.environment.dsv import Operation
 from roc.shell.scripts import render
 
+pytestmark = pytest.mark.slow  # real builds or a PowerShell parser: see README's quick loop
+
 
 def test_the_parser_finds_errors():
     """The checks below mean something only if the grammar rejects broken PowerShell."""

@@ -41,6 +41,7 @@ def test_posix_sh_with_spaces_and_non_ascii_in_the_path(tmp_path):
     assert result.stdout.strip() == f"{ws}/install/alpha"
 
 
+@pytest.mark.slow
 def test_changed_underlay_rebuilds_the_overlay(tmp_path):
     underlay, overlay = tmp_path / "underlay", tmp_path / "overlay"
     _plain(underlay, "lib_a")
@@ -57,6 +58,7 @@ def test_changed_underlay_rebuilds_the_overlay(tmp_path):
     assert "Finished <<< app_b" in rebuilt.stdout, rebuilt.stdout
 
 
+@pytest.mark.slow
 def test_symlinked_sources_are_tracked(tmp_path):
     shared = tmp_path / "shared.txt"
     shared.write_text("v1")
