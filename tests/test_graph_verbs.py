@@ -94,6 +94,25 @@ def test_json_shapes(demo):
     assert value == {"name": "pid_gains", "type": "double array", "value": [1.0, 0.1, 0.01]}
 
 
+EVERY_GRAPH_VERB = [
+    ("topic", "list"), ("topic", "list", "-c"), ("topic", "info", "-v", "/chatter"), ("topic", "type", "/chatter"),
+    ("topic", "find", "std_msgs/msg/String"), ("node", "list"), ("node", "info", "/talker"), ("service", "list"),
+    ("service", "type", "/motor_controller/enable"), ("service", "find", "std_srvs/srv/Trigger"), ("action", "list"),
+    ("action", "info", "/fibonacci"), ("action", "type", "/fibonacci"), ("param", "list", "/motor_controller"),
+    ("param", "get", "/motor_controller", "max_speed"), ("param", "describe", "/motor_controller", "max_speed"),
+    ("param", "dump", "/motor_controller"), ("interface", "list"), ("interface", "packages"),
+    ("interface", "package", "std_srvs"), ("interface", "show", "std_srvs/srv/SetBool"),
+    ("interface", "proto", "std_srvs/srv/SetBool"), ("daemon", "status"), ("daemon", "start"),
+]
+
+
+@pytest.mark.parametrize("command", EVERY_GRAPH_VERB, ids=" ".join)
+def test_every_verb_prints_json(demo, command):
+    got = roc(*command, "--format", "json", env=demo)
+    assert got.returncode == 0, got.stderr
+    assert isinstance(json.loads(got.stdout), (dict, list))
+
+
 def test_head_ends_quietly(demo):
     import subprocess
 
