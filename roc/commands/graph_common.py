@@ -46,6 +46,14 @@ def add_list_arguments(parser: argparse.ArgumentParser, noun: str, plural: str, 
     add_graph_arguments(parser)
 
 
+def add_find_arguments(parser: argparse.ArgumentParser, noun: str, plural: str, example: str) -> None:
+    """``TYPE``, ``-c`` and ``--include-hidden-PLURAL``, as ros2's ``NOUN find``."""
+    parser.add_argument(f"{noun}_type", help=f"type of the {noun}, e.g. {example}")
+    add_count_argument(parser, plural)
+    add_hidden_argument(parser, plural)
+    add_graph_arguments(parser)
+
+
 def visible(entries: list[dict[str, Any]], args: argparse.Namespace) -> list[dict[str, Any]]:
     """Without ``--include-hidden-...`` (or for verbs that have none), the entries with no hidden name."""
     if getattr(args, "include_hidden", True):

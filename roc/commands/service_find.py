@@ -4,15 +4,11 @@ from __future__ import annotations
 
 import argparse
 
-from roc.cli.options import add_graph_arguments
-from roc.commands.graph_common import add_count_argument, add_hidden_argument, run_find
+from roc.commands.graph_common import add_find_arguments, run_find
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("service_type", help="type of the service, e.g. std_srvs/srv/Empty")
-    add_count_argument(parser, "services")
-    add_hidden_argument(parser, "services")
-    add_graph_arguments(parser)
+    add_find_arguments(parser, "service", "services", "std_srvs/srv/Empty")
 
 
 def run(args: argparse.Namespace) -> int:
