@@ -44,6 +44,12 @@ SAME_AS_ROS2 = [
     ("param", "list"), ("param", "list", "/motor_controller"), ("param", "get", "/motor_controller", "max_speed"),
     ("param", "get", "/motor_controller", "wheel_names"), ("param", "get", "/motor_controller", "use_encoder"),
     ("param", "describe", "/motor_controller", "max_speed"), ("param", "dump", "/motor_controller"),
+    # counts, finds that match nothing, names that are not there but are not errors for ros2 either
+    ("service", "list", "-c"), ("action", "list", "-c"), ("topic", "find", "-c", "std_msgs/msg/String"),
+    ("topic", "find", "std_msgs/msg/Int32"), ("service", "find", "-c", "std_srvs/srv/Trigger"),
+    ("action", "info", "/nope"),
+    ("param", "list", "/motor_controller", "--param-type"),
+    ("param", "list", "/motor_controller", "--param-prefixes", "max", "pid"),
 ]
 
 
@@ -62,6 +68,7 @@ def test_same_output_as_ros2(demo, command):
     (("service", "type", "/nope"), "Unknown service '/nope'"),
     (("action", "type", "/nope"), "Unknown action '/nope'"),
     (("param", "get", "/nope", "x"), "Node not found"),
+    (("param", "get", "/motor_controller", "nope"), "Parameter not set"),
 ])
 def test_unknown_names_are_one_line_and_exit_1(demo, command, message):
     got = roc(*command, env=demo)
