@@ -63,6 +63,13 @@ def test_lifecycle(talker):
     assert not sock.exists()
     assert roc("daemon", "stop", env=env).stdout == "The daemon is not running\n"
 
+    # --all stops the daemons of every environment (here: the other domain's).
+    assert status(other)["running"]
+    assert roc("daemon", "stop", "--all", env=env).stdout == "Stopped 1 daemon\n"
+    assert status(other)["running"] is False
+    assert json.loads(roc("daemon", "stop", "--all", "--format", "json", env=env).stdout) == {"stopped": False,
+                                                                                            "count": 0}
+
 
 def test_concurrent_clients_share_one_daemon(talker):
     env = talker

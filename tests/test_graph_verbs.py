@@ -44,6 +44,12 @@ SAME_AS_ROS2 = [
     ("param", "list"), ("param", "list", "/motor_controller"), ("param", "get", "/motor_controller", "max_speed"),
     ("param", "get", "/motor_controller", "wheel_names"), ("param", "get", "/motor_controller", "use_encoder"),
     ("param", "describe", "/motor_controller", "max_speed"), ("param", "dump", "/motor_controller"),
+    # counts, finds that match nothing, names that are not there but are not errors for ros2 either
+    ("service", "list", "-c"), ("action", "list", "-c"), ("topic", "find", "-c", "std_msgs/msg/String"),
+    ("topic", "find", "std_msgs/msg/Int32"), ("service", "find", "-c", "std_srvs/srv/Trigger"),
+    ("action", "info", "/nope"),
+    ("param", "list", "/motor_controller", "--param-type"),
+    ("param", "list", "/motor_controller", "--param-prefixes", "max", "pid"),
 ]
 
 
@@ -62,6 +68,7 @@ def test_same_output_as_ros2(demo, command):
     (("service", "type", "/nope"), "Unknown service '/nope'"),
     (("action", "type", "/nope"), "Unknown action '/nope'"),
     (("param", "get", "/nope", "x"), "Node not found"),
+    (("param", "get", "/motor_controller", "nope"), "Parameter not set"),
 ])
 def test_unknown_names_are_one_line_and_exit_1(demo, command, message):
     got = roc(*command, env=demo)
@@ -92,6 +99,25 @@ def test_json_shapes(demo):
     assert {"name": "/chatter", "types": ["std_msgs/msg/String"]} in info["publishers"]
     value = json.loads(roc("param", "get", "/motor_controller", "pid_gains", "--format", "json", env=demo).stdout)
     assert value == {"name": "pid_gains", "type": "double array", "value": [1.0, 0.1, 0.01]}
+
+
+EVERY_GRAPH_VERB = [
+    ("topic", "list"), ("topic", "list", "-c"), ("topic", "info", "-v", "/chatter"), ("topic", "type", "/chatter"),
+    ("topic", "find", "std_msgs/msg/String"), ("node", "list"), ("node", "info", "/talker"), ("service", "list"),
+    ("service", "type", "/motor_controller/enable"), ("service", "find", "std_srvs/srv/Trigger"), ("action", "list"),
+    ("action", "info", "/fibonacci"), ("action", "type", "/fibonacci"), ("param", "list", "/motor_controller"),
+    ("param", "get", "/motor_controller", "max_speed"), ("param", "describe", "/motor_controller", "max_speed"),
+    ("param", "dump", "/motor_controller"), ("interface", "list"), ("interface", "packages"),
+    ("interface", "package", "std_srvs"), ("interface", "show", "std_srvs/srv/SetBool"),
+    ("interface", "proto", "std_srvs/srv/SetBool"), ("daemon", "status"), ("daemon", "start"),
+]
+
+
+@pytest.mark.parametrize("command", EVERY_GRAPH_VERB, ids=" ".join)
+def test_every_verb_prints_json(demo, command):
+    got = roc(*command, "--format", "json", env=demo)
+    assert got.returncode == 0, got.stderr
+    assert isinstance(json.loads(got.stdout), (dict, list))
 
 
 def test_head_ends_quietly(demo):

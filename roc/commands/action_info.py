@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 
 from roc.cli.options import add_graph_arguments
+from roc.commands.graph_common import ask
 from roc.render import render
-from roc.ros.client import query
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -23,8 +23,7 @@ def _entries(endpoints: list[dict], args: argparse.Namespace) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    info = query("action_info", {"action": args.action_name}, use_daemon=not args.no_daemon,
-                 spin_time=args.spin_time)
+    info = ask(args, "action_info", {"action": args.action_name})
     lines = [f"Action: {args.action_name}", f"Action clients: {len(info['clients'])}", *_entries(info["clients"], args),
              f"Action servers: {len(info['servers'])}", *_entries(info["servers"], args)]
     render(info, args.format, lines)

@@ -5,9 +5,7 @@ from __future__ import annotations
 import argparse
 
 from roc.cli.options import add_graph_arguments
-from roc.errors import RocError
-from roc.render import render
-from roc.ros.client import query
+from roc.commands.graph_common import run_type
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -16,9 +14,4 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    actions = query("snapshot", use_daemon=not args.no_daemon, spin_time=args.spin_time)["actions"]
-    types = next((a["types"] for a in actions if a["name"] == args.action_name), None)
-    if types is None:
-        raise RocError(f"Unknown action '{args.action_name}'")
-    render({"name": args.action_name, "types": types}, args.format, types)
-    return 0
+    return run_type(args, "actions", "action", args.action_name)

@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 
 from roc.cli.options import add_graph_arguments
+from roc.commands.graph_common import ask
 from roc.render import render
-from roc.ros.client import query
 from roc.ros.present import is_hidden
 
 SECTIONS = (("subscribers", "Subscribers"), ("publishers", "Publishers"), ("service_servers", "Service Servers"),
@@ -21,7 +21,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    info = query("node_info", {"node": args.node_name}, use_daemon=not args.no_daemon, spin_time=args.spin_time)
+    info = ask(args, "node_info", {"node": args.node_name})
     for key, _ in SECTIONS:
         info[key] = [e for e in info[key] if args.include_hidden or not is_hidden(e["name"])]
     lines = [info["name"]]

@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 
 from roc.cli.options import add_graph_arguments
+from roc.commands.graph_common import ask
 from roc.render import render
-from roc.ros.client import query
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -33,7 +33,6 @@ def descriptor_lines(d: dict) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    descriptors = query("param_describe", {"node": args.node_name, "names": args.parameter_names},
-                        use_daemon=not args.no_daemon, spin_time=args.spin_time)
+    descriptors = ask(args, "param_describe", {"node": args.node_name, "names": args.parameter_names})
     render(descriptors, args.format, [line for d in descriptors for line in descriptor_lines(d)])
     return 0

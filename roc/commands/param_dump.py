@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 
 from roc.cli.options import add_graph_arguments
+from roc.commands.graph_common import ask
 from roc.render import render, to_yaml
-from roc.ros.client import query
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -27,7 +27,7 @@ def nested(values: dict[str, dict]) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    values = query("param_dump", {"node": args.node_name}, use_daemon=not args.no_daemon, spin_time=args.spin_time)
+    values = ask(args, "param_dump", {"node": args.node_name})
     document = {args.node_name: {"ros__parameters": nested(values)}}
     render(document, args.format, [to_yaml(document)])
     return 0

@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 
 from roc.cli.options import add_graph_arguments
+from roc.commands.graph_common import ask
 from roc.errors import RocError
 from roc.render import render
-from roc.ros.client import query
 
 LABELS = {"boolean": "Boolean value is:", "integer": "Integer value is:", "double": "Double value is:",
           "string": "String value is:", "byte array": "Byte values are:", "boolean array": "Boolean values are:",
@@ -28,8 +28,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    values = query("param_get", {"node": args.node_name, "names": [args.parameter_name]},
-                   use_daemon=not args.no_daemon, spin_time=args.spin_time)
+    values = ask(args, "param_get", {"node": args.node_name, "names": [args.parameter_name]})
     if not values:
         raise RocError("Parameter not set")
     value = values[0]

@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 
 from roc.cli.options import add_graph_arguments
+from roc.commands.graph_common import ask
 from roc.render import render
-from roc.ros.client import query
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -18,8 +18,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    nodes = query("param_list", {"node": args.node_name, "prefixes": args.param_prefixes, "types": args.param_type},
-                  use_daemon=not args.no_daemon, spin_time=args.spin_time)
+    nodes = ask(args, "param_list", {"node": args.node_name, "prefixes": args.param_prefixes, "types": args.param_type})
     lines = []
     for entry in nodes:
         if not args.node_name:

@@ -7,8 +7,8 @@ import argparse
 import sys
 
 from roc.cli.options import add_graph_arguments
+from roc.commands.graph_common import ask
 from roc.render import print_lines, render
-from roc.ros.client import query
 from roc.ros.present import endpoint_lines, problem_line, topic_problems
 
 
@@ -20,8 +20,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    info = query("topic_endpoints", {"topic": args.topic_name}, use_daemon=not args.no_daemon,
-                 spin_time=args.spin_time)
+    info = ask(args, "topic_endpoints", {"topic": args.topic_name})
     problems = topic_problems(info)
     type_line = f"Type: {', '.join(info['types'])}"
     if args.verbose:

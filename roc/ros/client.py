@@ -176,9 +176,9 @@ def _wait_gone(path: Path, timeout: float = 5.0) -> None:
         time.sleep(0.05)
 
 
-def stop_daemon() -> bool:
-    """Stop this environment's daemon; False when none was running."""
-    path = socket_path()
+def stop_daemon(path: Path | None = None) -> bool:
+    """Stop this environment's daemon (or the one at ``path``); False when none was running."""
+    path = path or socket_path()
     connection = connect(path)
     if connection is None:
         return False
@@ -188,6 +188,11 @@ def stop_daemon() -> bool:
         connection.close()
     _wait_gone(path)
     return True
+
+
+def stop_all_daemons() -> int:
+    """Stop every roc daemon of this user, whatever its discovery environment; how many were running."""
+    return sum(stop_daemon(path) for path in sorted(runtime_dir().glob("daemon-*.sock")))
 
 
 def daemon_status() -> dict[str, Any] | None:

@@ -1,0 +1,158 @@
+"""Fast unit tests of the graph verbs' shared pieces (no ROS graph): listings, find and type verbs on a
+fixed snapshot, the daemon's replacement check and daemon-less discovery's quiet period."""
+
+from __future__ import annotations
+
+import json
+import time
+
+import pytest
+
+from roc.cli.main import main
+
+SNAPSHOT = {
+    "topics": [{"name": "/_hidden/t", "types": ["std_msgs/msg/String"], "publishers": 1, "subscribers": 0},
+               {"name": "/chatter", "types": ["std_msgs/msg/String"], "publishers": 1, "subscribers": 2},
+               {"name": "/odom", "types": ["nav_msgs/msg/Odometry"], "publishers": 0, "subscribers": 1}],
+    "services": [{"name": "/a/_private", "types": ["std_srvs/srv/Empty"]},
+                 {"name": "/reset", "types": ["std_srvs/srv/Empty"]}],
+    "actions": [{"name": "/fibonacci", "types": ["test_msgs/action/Fibonacci"]}],
+    "nodes": [{"name": "talker", "namespace": "/", "full_name": "/talker"},
+              {"name": "_roc_1", "namespace": "/", "full_name": "/_roc_1"},
+              {"name": "talker", "namespace": "/", "full_name": "/talker"}],
+}
+
+
+@pytest.fixture
+def graph(monkeypatch):
+    """Graph verbs answer from SNAPSHOT; returns a runner giving (exit code, stdout, stderr)."""
+    calls = []
+
+    def fake_query(method, params=None, *, use_daemon=True, spin_time=None):
+        calls.append((method, use_daemon, spin_time))
+        return json.loads(json.dumps(SNAPSHOT))
+
+    monkeypatch.setattr("roc.commands.graph_common.query", fake_query)
+
+    def run(capsys, *argv):
+        code = main(list(argv))
+        out, err = capsys.readouterr()
+        return code, out, err
+
+    run.calls = calls
+    return run
+
+
+@pytest.mark.parametrize("argv, expected", [
+    (("topic", "list"), "/chatter\n/odom\n"),
+    (("topic", "list", "--include-hidden-topics"), "/_hidden/t\n/chatter\n/odom\n"),
+    (("topic", "list", "-t"), "/chatter [std_msgs/msg/String]\n/odom [nav_msgs/msg/Odometry]\n"),
+    (("topic", "list", "-c"), "2\n"),
+    (("topic", "list", "--count-topics", "--include-hidden-topics"), "3\n"),
+    (("topic", "list", "-v"), "Published topics:\n * /chatter [std_msgs/msg/String] 1 publisher\n\n"
+                              "Subscribed topics:\n * /chatter [std_msgs/msg/String] 2 subscribers\n"
+                              " * /odom [nav_msgs/msg/Odometry] 1 subscriber\n\n"),
+    (("service", "list", "-t"), "/reset [std_srvs/srv/Empty]\n"),
+    (("service", "list", "--include-hidden-services", "-c"), "2\n"),
+    (("action", "list", "-t"), "/fibonacci [test_msgs/action/Fibonacci]\n"),
+    (("action", "list", "--count-actions"), "1\n"),
+    (("topic", "find", "std_msgs/msg/String"), "/chatter\n"),
+    (("topic", "find", "-c", "--include-hidden-topics", "std_msgs/msg/String"), "2\n"),
+    (("service", "find", "std_srvs/srv/Empty", "--include-hidden-services"), "/a/_private\n/reset\n"),
+    (("service", "find", "-c", "std_srvs/srv/Nope"), "0\n"),
+    (("topic", "type", "/odom"), "nav_msgs/msg/Odometry\n"),
+    (("service", "type", "/reset"), "std_srvs/srv/Empty\n"),
+    (("action", "type", "/fibonacci"), "test_msgs/action/Fibonacci\n"),
+    (("node", "list", "-a"), "/_roc_1\n/talker\n/talker\n"),
+    (("node", "list", "--count-nodes"), "2\n"),
+])
+def test_listings_as_ros2(graph, capsys, argv, expected):
+    code, out, _ = graph(capsys, *argv)
+    assert (code, out) == (0, expected)
+
+
+def test_json_shapes_of_listings(graph, capsys):
+    assert json.loads(graph(capsys, "topic", "list", "-c", "--format", "json")[1]) == {"count": 2}
+    assert json.loads(graph(capsys, "service", "list", "--format", "json")[1]) == [
+        {"name": "/reset", "types": ["std_srvs/srv/Empty"]}]
+    assert json.loads(graph(capsys, "topic", "find", "std_msgs/msg/String", "--format", "json")[1]) == ["/chatter"]
+    assert json.loads(graph(capsys, "action", "type", "/fibonacci", "--format", "json")[1]) == {
+        "name": "/fibonacci", "types": ["test_msgs/action/Fibonacci"]}
+    assert json.loads(graph(capsys, "node", "list", "--format", "json")[1]) == [
+        {"name": "/talker", "duplicate": True}, {"name": "/talker", "duplicate": True}]
+
+
+def test_duplicate_node_names_warned_once(graph, capsys):
+    code, out, err = graph(capsys, "node", "list")
+    assert (code, out) == (0, "/talker\n/talker\n")
+    assert err.splitlines() == ["roc: warning: several nodes are named /talker: 2 nodes; give each a unique name "
+                                "(parameters, services and node info mix them up)"]
+
+
+@pytest.mark.parametrize("noun", ["topic", "service", "action"])
+def test_unknown_name_is_ros2s_message(graph, capsys, noun):
+    code, out, err = graph(capsys, noun, "type", "/nope")
+    assert (code, out, err) == (1, "", f"roc: error: Unknown {noun} '/nope'\n")
+
+
+def test_no_daemon_and_spin_time_reach_the_query(graph, capsys):
+    graph(capsys, "topic", "list")
+    graph(capsys, "service", "find", "x", "--no-daemon", "--spin-time", "0.7")
+    assert graph.calls == [("snapshot", True, None), ("snapshot", False, 0.7)]
+
+
+class FakeConnection:
+    def __init__(self, hello):
+        self.hello, self.sent, self.closed = hello, [], False
+
+    def request(self, method, params=None, timeout=None):
+        self.sent.append(method)
+        return self.hello if method == "hello" else {"stopping": True}
+
+    def close(self):
+        self.closed = True
+
+
+def test_daemon_of_another_version_or_environment_is_shut_down():
+    from roc import __version__
+    from roc.ros.client import _usable, discovery_environment
+
+    same = FakeConnection({"version": __version__, "environment": discovery_environment()})
+    assert _usable(same) and same.sent == ["hello"] and not same.closed
+    for hello in ({"version": "0.0.0-other", "environment": discovery_environment()},
+                  {"version": __version__, "environment": {**discovery_environment(), "ROS_DOMAIN_ID": "x"}}):
+        other = FakeConnection(hello)
+        assert not _usable(other)
+        assert other.sent == ["hello", "shutdown"] and other.closed
+
+
+class FakeGraph:
+    """Stands in for roc.ros.graph.Graph: its signature changes until ``settles_at`` seconds."""
+
+    def __init__(self, settles_at: float):
+        self.start = time.monotonic()
+        self.settles_at = settles_at
+
+    def signature(self):
+        elapsed = time.monotonic() - self.start
+        return round(elapsed, 2) if elapsed < self.settles_at else "settled"
+
+    def _complete(self):
+        return True
+
+
+def test_discovery_waits_for_a_quiet_graph_bounded_by_spin_time():
+    pytest.importorskip("rclpy")
+    from roc.ros.graph import EXTRA_SECONDS, Graph
+
+    def waited(graph, period, quiet):
+        start = time.monotonic()
+        Graph.wait_for_discovery(graph, period, quiet)
+        return time.monotonic() - start
+
+    # Quiet from the start: returns at the period (--spin-time), not later.
+    assert 0.2 <= waited(FakeGraph(0), 0.2, 0.1) < 0.2 + EXTRA_SECONDS
+    # Changing until 0.5 s: waits past the period until quiet for 0.2 s.
+    assert 0.7 <= waited(FakeGraph(0.5), 0.2, 0.2) < 0.2 + EXTRA_SECONDS
+    # Never quiet: stops at the period plus EXTRA_SECONDS.
+    assert waited(FakeGraph(60), 0.1, 0.2) == pytest.approx(0.1 + EXTRA_SECONDS, abs=0.3)
