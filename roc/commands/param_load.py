@@ -10,10 +10,10 @@ from typing import Any
 import yaml
 
 from roc.cli.options import add_graph_arguments
+from roc.commands.graph_common import ask
 from roc.commands.param_set import report, set_parameters, typed_value
 from roc.errors import UsageError
 from roc.messages import warn
-from roc.ros.client import query
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -63,8 +63,7 @@ def run(args: argparse.Namespace) -> int:
     """Read-only parameters (which param dump writes too) are left out with a note, so that a dump
     loads back; exit 1 when the node refused another."""
     values = file_parameters(args.parameter_file, args.node_name)
-    descriptors = query("param_describe", {"node": args.node_name, "names": list(values)},
-                        use_daemon=not args.no_daemon, spin_time=args.spin_time)
+    descriptors = ask(args, "param_describe", {"node": args.node_name, "names": list(values)})
     read_only = [d["name"] for d in descriptors if d["read_only"]]
     for name in read_only:
         warn(f"{args.parameter_file}: {name} is read-only on {args.node_name}; not set")

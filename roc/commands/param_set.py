@@ -10,9 +10,9 @@ from typing import Any
 import yaml
 
 from roc.cli.options import add_graph_arguments
+from roc.commands.graph_common import ask
 from roc.errors import UsageError
 from roc.render import print_lines, render
-from roc.ros.client import query
 
 ARRAY_TYPES = ((bool, "boolean array"), (int, "integer array"), (float, "double array"), (str, "string array"))
 
@@ -45,8 +45,7 @@ def parse_value(text: str) -> dict[str, Any]:
 
 def set_parameters(args: argparse.Namespace, node: str, parameters: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Send the parameters ({name, type, value}) to the node; the node's verdict per parameter."""
-    return query("param_set", {"node": node, "parameters": parameters}, use_daemon=not args.no_daemon,
-                 spin_time=args.spin_time)
+    return ask(args, "param_set", {"node": node, "parameters": parameters})
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
