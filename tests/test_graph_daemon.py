@@ -133,3 +133,23 @@ def test_broken_pipe_is_quiet(talker):
     done = subprocess.run(f"'{BIN / 'roc'}' topic list --no-daemon --spin-time 0.5 | head -0", shell=True,
                           env=talker, capture_output=True, text=True, timeout=60)
     assert done.stderr == ""
+
+
+@pytest.mark.parametrize("variable, value", [("ROS_DOMAIN_ID", "7"), ("RMW_IMPLEMENTATION", "rmw_cyclonedds_cpp"),
+                                             ("ROS_AUTOMATIC_DISCOVERY_RANGE", "SUBNET"),
+                                             ("ROS_STATIC_PEERS", "192.168.1.2"), ("ROS_LOCALHOST_ONLY", "1")])
+def test_each_discovery_variable_has_its_own_daemon(variable: str, value: str) -> None:
+    from roc.ros.client import daemon_key
+
+    base = {"ROS_DOMAIN_ID": "3", "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST", "PATH": "/usr/bin"}
+    assert daemon_key({**base, variable: value}) != daemon_key(base)
+    assert daemon_key({**base, "PATH": "/elsewhere", "HOME": "/tmp"}) == daemon_key(base)
+
+
+def test_the_graph_honours_the_discovery_range(talker):
+    """rcl applies the variables to roc's participant as to ros2's: with automatic discovery off (and no
+    static peer) the talker on localhost is not found."""
+    seen = roc("node", "list", "--no-daemon", "--spin-time", "1", env=talker).stdout.split()
+    assert "/talker" in seen
+    off = roc("node", "list", "--no-daemon", "--spin-time", "1", env={**talker, "ROS_AUTOMATIC_DISCOVERY_RANGE": "OFF"})
+    assert off.returncode == 0 and "/talker" not in off.stdout.split()
