@@ -17,18 +17,13 @@ import argparse
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from graph_bench import (  # noqa: E402
     DEMO_GRAPH,
-    graph_env,
-    install_oracle,
-    start_nodes,
-    start_daemons,
-    stop_everything,
+    live_graph,
     tool,
     tool_env,
 )
@@ -85,16 +80,8 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=3)
     options = parser.parse_args()
-    reason = install_oracle()
-    if reason:
-        raise SystemExit(f"the ros2 CLI is not available: {reason}")
-    work = Path(tempfile.mkdtemp(prefix="roc-check-bench-"))
-    env = graph_env(94, work)
-    env["ROS_DOMAIN_ID"] = "94"
-    processes = start_nodes([*DEMO_GRAPH, [RATED[0]]], env)
-    check = check_file(work)
-    try:
-        start_daemons(env)
+    with live_graph(94, [*DEMO_GRAPH, [RATED[0]]]) as (env, work):
+        check = check_file(work)
         times: dict[str, list[float]] = {"roc": [], "ros2": []}
         failed = {"roc": 0, "ros2": 0}
         for _ in range(options.runs):
@@ -107,8 +94,6 @@ def main() -> int:
         roc_time, ros2_time = statistics.median(times["roc"]), statistics.median(times["ros2"])
         print(f"20 probes: roc graph check {roc_time:.2f} s, sequential ros2 CLI {ros2_time:.2f} s, "
               f"roc/ros2 {roc_time / ros2_time:.2f} (failed runs: roc {failed['roc']}, ros2 commands {failed['ros2']})")
-    finally:
-        stop_everything(env, processes)
     return 0
 
 

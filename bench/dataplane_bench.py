@@ -22,17 +22,12 @@ import signal
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from graph_bench import (  # noqa: E402
-    graph_env,
-    install_oracle,
-    start_nodes,
-    start_daemons,
-    stop_everything,
+    live_graph,
     timed,
     tool,
     tool_env,
@@ -93,14 +88,7 @@ def main() -> int:
     parser.add_argument("--rates", type=float, nargs="*", default=[1000, 5000], metavar="HZ")
     parser.add_argument("--seconds", type=float, default=10)
     options = parser.parse_args()
-    reason = install_oracle()
-    if reason:
-        raise SystemExit(f"the ros2 CLI is not available: {reason}")
-    env = graph_env(91, Path(tempfile.mkdtemp(prefix="roc-dataplane-bench-")))
-    env["ROS_DOMAIN_ID"] = "91"
-    processes = start_nodes(GRAPH, env)
-    try:
-        start_daemons(env)
+    with live_graph(91, GRAPH) as (env, work):
         print(f"{'command':75} {'roc s':>7} {'ros2 s':>7} {'roc/ros2':>8}  failed runs roc, ros2")
         for command in COMMANDS:
             times: dict[str, list[float]] = {"roc": [], "ros2": []}
@@ -113,7 +101,6 @@ def main() -> int:
             roc_time, ros2_time = statistics.median(times["roc"]), statistics.median(times["ros2"])
             print(f"{' '.join(command):75} {roc_time:7.3f} {ros2_time:7.3f} {roc_time / ros2_time:8.2f}  "
                   f"{failed['roc']}, {failed['ros2']}")
-        work = Path(tempfile.mkdtemp(prefix="roc-dataplane-rates-"))
         for rate in options.rates:
             row = rate_run(env, rate, options.seconds, work)
             truth = row["true rate"]
@@ -124,8 +111,6 @@ def main() -> int:
             print(f"  hz: roc {error('roc hz')}, ros2 {error('ros2 hz')}")
             print(f"  received: rclpy subscriber {row['rclpy subscriber']}, roc echo {row['roc echo']} "
                   f"(reported lost {row['roc echo lost']}), ros2 echo {row['ros2 echo']}")
-    finally:
-        stop_everything(env, processes)
     return 0
 
 

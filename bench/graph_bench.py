@@ -18,6 +18,7 @@ six nodes. Targets: warm roc at most 1/4 of ros2's warm time; daemon-less comple
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import statistics
 import subprocess
@@ -27,7 +28,16 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from graph_helpers import BIN, DEMO_GRAPH, ORACLE_VENV, graph_env, install_oracle, start_nodes, stop_all, stop_daemon  # noqa: E402
+from graph_helpers import (  # noqa: E402
+    BIN,
+    DEMO_GRAPH,
+    ORACLE_VENV,
+    graph_env,
+    install_oracle,
+    start_nodes,
+    stop_all,
+    stop_daemon,
+)
 
 COMMANDS = [("topic", "list"), ("topic", "info", "-v", "/chatter"), ("node", "list"),
             ("param", "get", "/motor_controller", "max_speed")]
@@ -59,17 +69,26 @@ def timed(name: str, args: tuple[str, ...], env: dict[str, str], boot: bool = Tr
     return time.perf_counter() - start, done.stdout, done.returncode
 
 
-def start_daemons(env: dict[str, str]) -> None:
-    """Both tools' daemons, started and given a discovery period."""
-    for name in ("roc", "ros2"):
-        subprocess.run([tool(name), "daemon", "start"], env=env, capture_output=True, timeout=60)
-    time.sleep(4)
-
-
-def stop_everything(env: dict[str, str], processes: list) -> None:
-    """Both daemons and the graph's processes."""
-    stop_daemon(env)
-    stop_all(processes)
+@contextlib.contextmanager
+def live_graph(domain: int, specs: list):
+    """The ros2 oracle installed, the nodes of ``specs`` running in ROS domain ``domain``, both tools'
+    daemons started and given a discovery period; everything stopped afterwards. Yields the
+    environment and a fresh work directory."""
+    reason = install_oracle()
+    if reason:
+        raise SystemExit(f"the ros2 CLI is not available: {reason}")
+    work = Path(tempfile.mkdtemp(prefix="roc-bench-"))
+    env = graph_env(domain, work)
+    env["ROS_DOMAIN_ID"] = str(domain)
+    processes = start_nodes(specs, env)
+    try:
+        for name in ("roc", "ros2"):
+            subprocess.run([tool(name), "daemon", "start"], env=env, capture_output=True, timeout=60)
+        time.sleep(4)
+        yield env, work
+    finally:
+        stop_daemon(env)
+        stop_all(processes)
 
 
 def compare(env: dict[str, str], runs: int, extra: tuple[str, ...], boot: bool) -> list[tuple]:
@@ -94,15 +113,7 @@ def main() -> int:
     parser.add_argument("--no-daemon-runs", type=int, default=3)
     parser.add_argument("--completeness-runs", type=int, default=20)
     options = parser.parse_args()
-    reason = install_oracle()
-    if reason:
-        raise SystemExit(f"the ros2 CLI is not available: {reason}")
-    runtime = Path(tempfile.mkdtemp(prefix="roc-graph-bench-"))
-    env = graph_env(90, runtime)
-    env["ROS_DOMAIN_ID"] = "90"
-    processes = start_nodes(DEMO_GRAPH, env)
-    try:
-        start_daemons(env)
+    with live_graph(90, DEMO_GRAPH) as (env, _):
         for name in ("roc", "ros2"):  # warm-up
             timed(name, ("topic", "list"), env)
         print(f"{'command':50} {'roc s':>7} {'ros2 s':>7} {'roc/ros2':>8}  failed runs roc, ros2")
@@ -117,8 +128,6 @@ def main() -> int:
                 _, out, _ = timed(name, ("node", "list", "--no-daemon"), env)
                 complete += out.splitlines() == NODES
             print(f"{name} node list --no-daemon complete in {complete} of {options.completeness_runs} runs")
-    finally:
-        stop_everything(env, processes)
     return 0
 
 
