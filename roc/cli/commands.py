@@ -77,6 +77,7 @@ COMMANDS = (
     (("frame", "monitor"), (), "frame_monitor", "rate and delay of each frame, live (like tf2_monitor)"),
     (("frame", "pub"), (), "frame_pub", "publish a transform, static or at a rate (like static_transform_publisher)"),
     (("frame", "convert"), (), "frame_convert", "convert rotations between representations; compose and invert transforms"),
+    (("bridge",), (), "bridge", "bridge topics from one ROS domain into another (like domain_bridge)"),
     (("daemon",), (), None, "the roc daemon (a warm graph participant): start, stop, status"),
     (("daemon", "start"), (), "daemon_start", "start the roc daemon of this discovery environment"),
     (("daemon", "stop"), (), "daemon_stop", "stop the roc daemon of this discovery environment"),

@@ -77,11 +77,12 @@ def full_name(namespace: str, name: str) -> str:
 
 
 class Graph:
-    """A hidden rclpy node in its own context, spun in a background thread (for service calls)."""
+    """A hidden rclpy node in its own context, spun in a background thread (for service calls); in
+    ``domain_id`` when given, else in the environment's ROS domain."""
 
-    def __init__(self, node_name: str | None = None) -> None:
+    def __init__(self, node_name: str | None = None, domain_id: int | None = None) -> None:
         self.context = Context()
-        rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)
+        rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO, domain_id=domain_id)
         self.node = Node(node_name or f"_roc_{os.getpid()}", context=self.context, start_parameter_services=False,
                          enable_rosout=False)
         self.executor = SingleThreadedExecutor(context=self.context)

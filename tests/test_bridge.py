@@ -1,0 +1,143 @@
+"""roc bridge between two ROS domains, with real rclpy nodes on each side."""
+
+from __future__ import annotations
+
+import json
+import queue
+import signal
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+import pytest
+from build_helpers import BIN, ros_domain_id, stop_process
+from graph_helpers import graph_env, roc, start_nodes, stop_all
+
+pytestmark = pytest.mark.slow
+
+TALKER = {"name": "talker", "publishers": [
+    {"topic": "chatter", "type": "std_msgs/msg/String", "values": {"data": "hi"}, "rate_hz": 20},
+    {"topic": "latched", "type": "std_msgs/msg/String", "values": {"data": "kept"}, "durability": "transient_local",
+     "depth": 1},
+    {"topic": "cmd", "type": "geometry_msgs/msg/Twist", "values": {}, "rate_hz": 20, "reliability": "best_effort"}]}
+
+
+@pytest.fixture
+def domains(tmp_path):
+    """Two ROS domains of this worker's own (A with a talker), and an environment for each."""
+    a = graph_env(100, tmp_path / "a")
+    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(110)}
+    processes = start_nodes([[TALKER]], a)
+    yield a, b
+    stop_all(processes)
+
+
+def _bridge(*args: str, env: dict[str, str]) -> subprocess.Popen:
+    """A running ``roc bridge``; its stdout lines go to ``.lines`` (a queue), so no read can hang."""
+    process = subprocess.Popen([str(BIN / "roc"), "bridge", *args], env=env, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    process.lines = queue.SimpleQueue()
+    threading.Thread(target=lambda: [process.lines.put(line) for line in process.stdout], daemon=True).start()
+    return process
+
+
+def _line(process: subprocess.Popen, deadline: float) -> str:
+    try:
+        return process.lines.get(timeout=max(0.1, deadline - time.monotonic()))
+    except queue.Empty:
+        raise AssertionError("roc bridge printed nothing more in time") from None
+
+
+def _bridging_lines(process: subprocess.Popen, count: int, seconds: float = 20) -> list[str]:
+    """The first ``count`` "bridging ..." lines the bridge prints (rate tables in between left out)."""
+    lines: list[str] = []
+    deadline = time.monotonic() + seconds
+    while len(lines) < count:
+        assert time.monotonic() < deadline, lines
+        line = _line(process, deadline)
+        if line.startswith("bridging "):
+            lines.append(line)
+    return lines
+
+
+def _events_until(process: subprocess.Popen, topic: str, seconds: float = 20) -> list[dict]:
+    """The JSON events the bridge prints until it bridges ``topic`` (which it must within ``seconds``)."""
+    events: list[dict] = []
+    deadline = time.monotonic() + seconds
+    while not any(e["event"] == "bridging" and e["topic"] == topic for e in events):
+        assert time.monotonic() < deadline, events
+        events.append(json.loads(_line(process, deadline)))
+    return events
+
+
+def _stop(process: subprocess.Popen) -> int:
+    process.send_signal(signal.SIGINT)
+    try:
+        return process.wait(timeout=15)
+    finally:
+        stop_process(process)
+
+
+def test_topics_arrive_in_the_other_domain_with_their_qos(domains) -> None:
+    a, b = domains
+    bridge = _bridge("--from-domain", a["ROS_DOMAIN_ID"], "--to-domain", b["ROS_DOMAIN_ID"], "/chatter", "latched",
+                     "/cmd", env=a)
+    try:
+        announced = sorted(_bridging_lines(bridge, 3))
+        assert announced == [
+            f"bridging /chatter [std_msgs/msg/String] domain {a['ROS_DOMAIN_ID']} -> {b['ROS_DOMAIN_ID']} (reliable, volatile)\n",
+            f"bridging /cmd [geometry_msgs/msg/Twist] domain {a['ROS_DOMAIN_ID']} -> {b['ROS_DOMAIN_ID']} (best_effort, volatile)\n",
+            f"bridging /latched [std_msgs/msg/String] domain {a['ROS_DOMAIN_ID']} -> {b['ROS_DOMAIN_ID']} (reliable, transient_local)\n"]
+        echoed = roc("topic", "echo", "/chatter", "--once", "--no-daemon", env=b)
+        assert (echoed.returncode, echoed.stdout) == (0, "data: hi\n---\n")
+        kept = roc("topic", "echo", "/latched", "--once", "--no-daemon", env=b)  # published once, before
+        assert (kept.returncode, kept.stdout) == (0, "data: kept\n---\n")
+        info = json.loads(roc("topic", "info", "-v", "/latched", "--format", "json", "--no-daemon", env=b).stdout)
+        assert [p["qos"]["durability"] for p in info["publishers"]] == ["TRANSIENT_LOCAL"]
+        twist = roc("topic", "echo", "/cmd", "--once", "--no-daemon", "--field", "linear.x", env=b)
+        assert (twist.returncode, twist.stdout) == (0, "0.0\n---\n")
+    finally:
+        assert _stop(bridge) == 130
+
+
+def test_all_picks_up_a_late_publisher_and_a_config_remaps(domains, tmp_path: Path) -> None:
+    a, b = domains
+    config = tmp_path / "bridge.yaml"
+    config.write_text(f"name: test\nfrom_domain: {a['ROS_DOMAIN_ID']}\nto_domain: {b['ROS_DOMAIN_ID']}\n"
+                      "topics:\n  chatter:\n    type: std_msgs/msg/String\n    remap: chatter_b\n")
+    bridge = _bridge("--config", str(config), "--all", "--from-domain", a["ROS_DOMAIN_ID"], "--to-domain",
+                     b["ROS_DOMAIN_ID"], "--exclude", "^/(rosout|parameter_events|latched|cmd)$", "--format", "json",
+                     env=a)
+    late = None
+    try:
+        events = _events_until(bridge, "/chatter")
+        chatter = next(e for e in events if e.get("topic") == "/chatter")
+        assert (chatter["target"], chatter["from_domain"]) == ("/chatter_b", int(a["ROS_DOMAIN_ID"]))
+        late = start_nodes([[{"name": "late", "publishers": [
+            {"topic": "late_news", "type": "std_msgs/msg/String", "values": {"data": "new"}, "rate_hz": 10}]}]], a)
+        events += _events_until(bridge, "/late_news")
+        assert roc("topic", "echo", "/late_news", "--once", "--no-daemon", env=b).stdout == "data: new\n---\n"
+        assert roc("topic", "echo", "/chatter_b", "--once", "--no-daemon", env=b).stdout == "data: hi\n---\n"
+        rates = next(e for e in events if e["event"] == "rates")["rates"]
+        assert all(key.endswith(f"({a['ROS_DOMAIN_ID']}->{b['ROS_DOMAIN_ID']})") for key in rates)
+    finally:
+        assert _stop(bridge) == 130
+        if late:
+            stop_all(late)
+
+
+@pytest.mark.parametrize("args, config, error", [
+    (["/chatter"], None, "give --from-domain and --to-domain with topics or --all"),
+    (["--from-domain", "3", "--to-domain", "3", "/chatter"], None, "/chatter: bridging domain 3 into itself would loop"),
+    ([], "topics:\n  chatter:\n    type: std_msgs/msg/String\n    reversed: true\n",
+     "topics: chatter: 'reversed' and 'bidirectional' are not supported yet"),
+    ([], "topics:\n  chatter:\n    colour: red\n", "topics: chatter: unknown key 'colour'"),
+    ([], "from_domain: 999\ntopics:\n  chatter: {}\n", "topics: chatter: from_domain: expected a ROS domain id"),
+])
+def test_bad_bridges_are_one_line(tmp_path: Path, args: list[str], config: str | None, error: str) -> None:
+    if config is not None:
+        (tmp_path / "bridge.yaml").write_text(config)
+        args = [*args, "--config", str(tmp_path / "bridge.yaml")]
+    result = roc("bridge", *args, env=graph_env(100, tmp_path))
+    assert result.returncode == 2 and error in result.stderr.splitlines()[0], result.stderr
