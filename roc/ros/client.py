@@ -228,7 +228,7 @@ def stream(method: str, params: dict[str, Any], *, use_daemon: bool = True, hear
     ``heartbeats``: pass on the heartbeat events too (at least every 0.5 s, to act between events)."""
     skipped = () if heartbeats else ("heartbeat",)
     if not use_daemon:
-        from roc.ros.dataplane import local_stream
+        from roc.ros.streams import local_stream
 
         events = local_stream(method, params, **local)
         yield from (event for event in events if event.get("event") not in skipped)
@@ -279,7 +279,7 @@ class Session:
             return
         import contextlib
 
-        from roc.ros.dataplane import STREAMS
+        from roc.ros.streams import STREAMS
 
         with contextlib.closing(STREAMS[method](self.graph, params)) as events:
             yield from (event for event in events if heartbeats or event.get("event") != "heartbeat")

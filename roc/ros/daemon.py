@@ -113,7 +113,7 @@ class Daemon:
             else:
                 if not self.ready.wait(30):
                     raise RocError("the daemon's graph participant did not start")
-                from roc.ros.dataplane import STREAMS
+                from roc.ros.streams import STREAMS
 
                 params = request.get("params") or {}
                 if method in STREAMS:

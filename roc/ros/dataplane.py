@@ -1,7 +1,7 @@
-"""Moving data on a live graph: a subscription (``echo``) and a publisher (``publish``) on a Graph's
-node, each a stream of plain-data events. The same generators run inside the roc daemon (each event a
-line on the client's socket, so the endpoint lives in an already discovered participant) and in a
-daemon-less run. Messages travel as serialised CDR (base64 in JSON); the client turns them into
+"""Moving data on a live graph: subscriptions (``echo``, ``stats``, ``frames``) and a publisher
+(``publish``) on a Graph's node, each a stream of plain-data events (roc.ros.streams names them
+all). The same generators run inside the roc daemon (each event a line on the client's socket, so
+the endpoint lives in an already discovered participant) and in a daemon-less run. Messages travel as serialised CDR (base64 in JSON); the client turns them into
 message objects (``decode``), so the daemon never needs a verb's output options.
 
 A stream ends when its generator is closed: the daemon closes it when the client goes away (a
@@ -12,7 +12,6 @@ endpoint, so an interrupted client leaves none behind.
 from __future__ import annotations
 
 import base64
-import contextlib
 import queue
 import struct
 import threading
@@ -31,7 +30,7 @@ from rclpy.qos import (
 from rclpy.serialization import deserialize_message, serialize_message
 
 from roc.errors import RocError
-from roc.ros.types import action_class, message_class, service_class
+from roc.ros.types import message_class
 
 HEARTBEAT_SECONDS = 0.5
 MAX_BATCH = 1000  # messages in one ``messages`` event
@@ -257,97 +256,6 @@ def stats(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
             graph.node.destroy_subscription(subscription)
 
 
-def _wait(done: Callable[[], bool]) -> Iterator[dict[str, Any]]:
-    """Heartbeats until ``done()``."""
-    while not done():
-        yield {"event": "heartbeat"}
-
-
-def call(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
-    """Call ``params["service"]`` (a ``type`` service) with ``request`` (base64 CDR): ``waiting`` while
-    no server is available, then ``request`` and ``response {data}`` per call; with ``rate`` (Hz) again
-    and again until closed."""
-    cls = service_class(params["type"])
-    request = deserialize_message(base64.b64decode(params["request"]), cls.Request)
-    client = graph.node.create_client(cls, params["service"])
-    try:
-        if not client.wait_for_service(timeout_sec=0.1):
-            yield {"event": "waiting"}
-            yield from _wait(lambda: client.wait_for_service(timeout_sec=HEARTBEAT_SECONDS))
-        period, due = 1.0 / params["rate"] if params.get("rate") else None, time.monotonic()
-        while True:
-            yield {"event": "request"}
-            future = client.call_async(request)
-            yield from _wait(lambda: _done(future))
-            yield {"event": "response", "data": base64.b64encode(serialize(future.result())).decode()}
-            if period is None:
-                return
-            due += period
-            while (remaining := due - time.monotonic()) > 0:
-                time.sleep(min(remaining, HEARTBEAT_SECONDS))
-                yield {"event": "heartbeat"}
-    finally:
-        graph.node.destroy_client(client)
-
-
-GOAL_STATUS = {0: "UNKNOWN", 1: "ACCEPTED", 2: "EXECUTING", 3: "CANCELING", 4: "SUCCEEDED", 5: "CANCELED",
-               6: "ABORTED"}
-
-
-def goal(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
-    """Send ``params["goal"]`` (base64 CDR of a ``type`` action's Goal) to ``action``: ``waiting``
-    while no server is available, then ``accepted {goal_id}`` (or ``rejected``), ``feedback {data}``
-    (with ``feedback``), and ``result {data, status}``. Closed before the result, the goal is
-    canceled."""
-    from rclpy.action import ActionClient
-
-    cls = action_class(params["type"])
-    request = deserialize_message(base64.b64decode(params["goal"]), cls.Goal)
-    client = ActionClient(graph.node, cls, params["action"])
-    handle = None
-    try:
-        if not client.wait_for_server(timeout_sec=0.1):
-            yield {"event": "waiting"}
-            yield from _wait(lambda: client.wait_for_server(timeout_sec=HEARTBEAT_SECONDS))
-        feedback: queue.SimpleQueue = queue.SimpleQueue()
-        sent = client.send_goal_async(request, feedback_callback=feedback.put if params.get("feedback") else None)
-        yield from _wait(lambda: _done(sent))
-        handle = sent.result()
-        if not handle.accepted:
-            handle = None
-            yield {"event": "rejected"}
-            return
-        yield {"event": "accepted", "goal_id": bytes(handle.goal_id.uuid).hex()}
-        result = handle.get_result_async()
-        while True:
-            finished = _done(result)
-            while not feedback.empty():
-                message = feedback.get().feedback
-                yield {"event": "feedback", "data": base64.b64encode(serialize(message)).decode()}
-            if finished:
-                break
-            yield {"event": "heartbeat"}
-        outcome = result.result()
-        handle = None
-        yield {"event": "result", "data": base64.b64encode(serialize(outcome.result)).decode(),
-               "status": GOAL_STATUS.get(outcome.status, "UNKNOWN")}
-    finally:
-        if handle is not None:  # the client went away first: do not leave the goal running
-            canceled = threading.Event()
-            handle.cancel_goal_async().add_done_callback(lambda _: canceled.set())
-            canceled.wait(2.0)
-        client.destroy()
-
-
-def _done(future) -> bool:
-    """Whether ``future`` (completed by the Graph's executor thread) is done, waiting up to a
-    heartbeat for it."""
-    deadline = time.monotonic() + HEARTBEAT_SECONDS
-    while not future.done() and time.monotonic() < deadline:
-        time.sleep(0.005)
-    return future.done()
-
-
 TF_TYPE = "tf2_msgs/msg/TFMessage"
 
 
@@ -379,20 +287,3 @@ def frames(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
     finally:
         for subscription in subscriptions:
             graph.node.destroy_subscription(subscription)
-
-
-STREAMS = {"echo": echo, "publish": publish, "stats": stats, "call": call, "goal": goal, "frames": frames}
-
-
-def local_stream(method: str, params: dict[str, Any], node_name: str | None = None,
-                 **in_process: Any) -> Iterator[dict[str, Any]]:
-    """A stream without the daemon: its endpoint on a fresh participant of this process, on a node
-    named ``node_name`` (default: a hidden one)."""
-    from roc.ros.graph import Graph
-
-    graph = Graph(node_name)
-    try:
-        with contextlib.closing(STREAMS[method](graph, params, **in_process)) as events:
-            yield from events
-    finally:
-        graph.close()

@@ -1,0 +1,108 @@
+"""Service calls and action goals as streams of plain-data events (see roc.ros.dataplane): the request
+or goal travels as CDR, the client is created on the Graph's node and destroyed when the stream
+closes; a goal still running then is canceled."""
+
+from __future__ import annotations
+
+import base64
+import queue
+import threading
+import time
+from collections.abc import Callable, Iterator
+from typing import Any
+
+from rclpy.serialization import deserialize_message
+
+from roc.ros.dataplane import HEARTBEAT_SECONDS, serialize
+from roc.ros.types import action_class, service_class
+
+
+def _wait(done: Callable[[], bool]) -> Iterator[dict[str, Any]]:
+    """Heartbeats until ``done()``."""
+    while not done():
+        yield {"event": "heartbeat"}
+
+
+def call(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+    """Call ``params["service"]`` (a ``type`` service) with ``request`` (base64 CDR): ``waiting`` while
+    no server is available, then ``request`` and ``response {data}`` per call; with ``rate`` (Hz) again
+    and again until closed."""
+    cls = service_class(params["type"])
+    request = deserialize_message(base64.b64decode(params["request"]), cls.Request)
+    client = graph.node.create_client(cls, params["service"])
+    try:
+        if not client.wait_for_service(timeout_sec=0.1):
+            yield {"event": "waiting"}
+            yield from _wait(lambda: client.wait_for_service(timeout_sec=HEARTBEAT_SECONDS))
+        period, due = 1.0 / params["rate"] if params.get("rate") else None, time.monotonic()
+        while True:
+            yield {"event": "request"}
+            future = client.call_async(request)
+            yield from _wait(lambda: _done(future))
+            yield {"event": "response", "data": base64.b64encode(serialize(future.result())).decode()}
+            if period is None:
+                return
+            due += period
+            while (remaining := due - time.monotonic()) > 0:
+                time.sleep(min(remaining, HEARTBEAT_SECONDS))
+                yield {"event": "heartbeat"}
+    finally:
+        graph.node.destroy_client(client)
+
+
+GOAL_STATUS = {0: "UNKNOWN", 1: "ACCEPTED", 2: "EXECUTING", 3: "CANCELING", 4: "SUCCEEDED", 5: "CANCELED",
+               6: "ABORTED"}
+
+
+def goal(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+    """Send ``params["goal"]`` (base64 CDR of a ``type`` action's Goal) to ``action``: ``waiting``
+    while no server is available, then ``accepted {goal_id}`` (or ``rejected``), ``feedback {data}``
+    (with ``feedback``), and ``result {data, status}``. Closed before the result, the goal is
+    canceled."""
+    from rclpy.action import ActionClient
+
+    cls = action_class(params["type"])
+    request = deserialize_message(base64.b64decode(params["goal"]), cls.Goal)
+    client = ActionClient(graph.node, cls, params["action"])
+    handle = None
+    try:
+        if not client.wait_for_server(timeout_sec=0.1):
+            yield {"event": "waiting"}
+            yield from _wait(lambda: client.wait_for_server(timeout_sec=HEARTBEAT_SECONDS))
+        feedback: queue.SimpleQueue = queue.SimpleQueue()
+        sent = client.send_goal_async(request, feedback_callback=feedback.put if params.get("feedback") else None)
+        yield from _wait(lambda: _done(sent))
+        handle = sent.result()
+        if not handle.accepted:
+            handle = None
+            yield {"event": "rejected"}
+            return
+        yield {"event": "accepted", "goal_id": bytes(handle.goal_id.uuid).hex()}
+        result = handle.get_result_async()
+        while True:
+            finished = _done(result)
+            while not feedback.empty():
+                message = feedback.get().feedback
+                yield {"event": "feedback", "data": base64.b64encode(serialize(message)).decode()}
+            if finished:
+                break
+            yield {"event": "heartbeat"}
+        outcome = result.result()
+        handle = None
+        yield {"event": "result", "data": base64.b64encode(serialize(outcome.result)).decode(),
+               "status": GOAL_STATUS.get(outcome.status, "UNKNOWN")}
+    finally:
+        if handle is not None:  # the client went away first: do not leave the goal running
+            canceled = threading.Event()
+            handle.cancel_goal_async().add_done_callback(lambda _: canceled.set())
+            canceled.wait(2.0)
+        client.destroy()
+
+
+def _done(future) -> bool:
+    """Whether ``future`` (completed by the Graph's executor thread) is done, waiting up to a
+    heartbeat for it."""
+    deadline = time.monotonic() + HEARTBEAT_SECONDS
+    while not future.done() and time.monotonic() < deadline:
+        time.sleep(0.005)
+    return future.done()
