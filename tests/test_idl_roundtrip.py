@@ -68,6 +68,7 @@ def test_fields_constants_and_types_survive(round_trip, source):
             assert after[name].type == constant.type
 
 
+@pytest.mark.slow
 def test_round_trip_outputs_pass_rosidl_parser(round_trip, tmp_path):
     _, back = round_trip
     write(back, tmp_path / "out")

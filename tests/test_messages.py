@@ -111,6 +111,7 @@ def test_every_installed_package_is_enumerated() -> None:
     assert len(ALL_TYPES) > 200
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ALL_TYPES)
 def test_yaml_round_trip_matches_ros2(name: str, oracle: Any) -> None:
     """YAML -> message -> YAML gives the same text, equal to rosidl_runtime_py's for the same message,

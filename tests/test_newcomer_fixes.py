@@ -310,6 +310,7 @@ BASH_COMPLETIONS = [  # words after 'roc', the word completed last -> COMPREPLY
 ]
 
 
+@pytest.mark.slow
 def test_bash_completes_positional_package_names_and_every_list_value(tmp_path: Path) -> None:
     script = _completion_script("bash", tmp_path)
     workspace = copy_fixture("selection", tmp_path / "ws")
@@ -322,6 +323,7 @@ def test_bash_completes_positional_package_names_and_every_list_value(tmp_path: 
     assert result.stdout.splitlines() == [expected for _, expected in BASH_COMPLETIONS], result.stderr
 
 
+@pytest.mark.slow
 def test_zsh_completes_with_the_bash_function(tmp_path: Path) -> None:
     if shutil.which("zsh") is None:
         pytest.skip("zsh is not installed (scripts/setup.sh installs it when apt is available)")
@@ -349,6 +351,7 @@ def test_zsh_completes_with_the_bash_function(tmp_path: Path) -> None:
     ("roc work build --packages-start core a", ["app"]),
     ("roc work env ap", ["app"]),
 ])
+@pytest.mark.slow
 def test_fish_completes_positional_package_names_and_every_list_value(line: str, expected: list[str],
                                                                        tmp_path: Path) -> None:
     if shutil.which("fish") is None:
