@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import time
 
 import pytest
 
@@ -190,3 +191,30 @@ def test_jobserver_holds_jobs_minus_one_tokens_and_rewrites_makeflags() -> None:
             os.read(single.read_fd, 1)
     finally:
         single.close()
+
+
+def test_a_failure_aborts_the_running_tasks_and_stops_their_processes() -> None:
+    def long_command(context) -> None:
+        context.run(["sleep", "30"], cwd="/", env=os.environ)
+
+    def fail_soon(context) -> None:
+        time.sleep(0.3)
+        raise TaskError("broken")
+
+    tasks = [_task("long", action=long_command, weight=10.0), _task("bad", action=fail_soon),
+             _task("after", ("long",))]
+    start = time.monotonic()
+    result = execute(tasks, [], workers=2)
+    assert time.monotonic() - start < 10
+    assert result.failed == ["bad"] and result.aborted == ["long"] and result.not_started == ["after"]
+    assert not result.ok
+
+
+def test_a_command_that_cannot_start_fails_its_task() -> None:
+    def missing(context) -> None:
+        context.run(["/nonexistent/tool"], cwd="/", env=os.environ)
+
+    result, seen = _run([_task("a", action=missing)])
+    assert result.failed == ["a"]
+    assert [e.reason for e in seen if isinstance(e, TaskFailed)] == [
+        "cannot run '/nonexistent/tool': No such file or directory"]
