@@ -14,7 +14,7 @@ from roc.buildtypes.context import BuildOptions
 from roc.engine.events import TaskStarted
 from roc.errors import UsageError
 from roc.handlers import EVENT_HANDLERS, handler_switches
-from roc.handlers.logs import task_log_folder
+from roc.handlers.logs import LogHandler, task_log_folder
 from roc.workspace.package import Package
 
 
@@ -144,3 +144,21 @@ def test_task_log_folder_per_kind() -> None:
     assert task_log_folder(TaskStarted("p", "idl"), "build") == "p/idl"
     assert task_log_folder(TaskStarted("p", "test"), "test") == "p"
     assert task_log_folder(TaskStarted("p", "build"), "test") == "p/build"
+
+
+def test_log_handler_writes_each_kind_in_its_folder_and_every_event(tmp_path: Path) -> None:
+    from roc.engine.events import CommandEnded, CommandStarted, RunFinished, TaskOutput
+
+    handler = LogHandler(tmp_path, kind="build")
+    for event in (CommandStarted("p", "idl", command=("gen", "a b"), cwd="/w"), TaskOutput("p", "idl", data=b"gen\n"),
+                  CommandEnded("p", "idl", command=("gen", "a b"), returncode=0),
+                  TaskOutput("p", "build", stream="stderr", data=b"warn\n"), RunFinished("")):
+        handler(event)
+    files = {p.relative_to(tmp_path).as_posix(): p.read_text() for p in tmp_path.rglob("*") if p.is_file()}
+    assert set(files) == {"events.log", "p/idl/command.log", "p/idl/streams.log", "p/idl/stdout.log",
+                          "p/idl/stdout_stderr.log", "p/stderr.log", "p/stdout_stderr.log", "p/streams.log"}
+    assert files["p/idl/command.log"] == ("Invoking command in '/w': gen 'a b'\n"
+                                          "Invoked command 'gen 'a b'' returned '0'\n")
+    assert files["p/stderr.log"] == "warn\n"
+    assert [line.split('"')[3] for line in files["events.log"].splitlines()] == [
+        "CommandStarted", "TaskOutput", "CommandEnded", "TaskOutput", "RunFinished"]
