@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from build_helpers import BIN, roc, ros_env
 
-pytestmark = pytest.mark.slow  # real builds or a PowerShell parser: see README's quick loop
+pytestmark = pytest.mark.slow  # every test builds a workspace
 
 SHOW_MAKEFLAGS = """cmake_minimum_required(VERSION 3.8)
 project({name} C)
@@ -36,8 +36,13 @@ def _commands(ws: Path, package: str) -> str:
 
 def test_configure_runs_only_when_needed(ws):
     assert roc("work", "build", cwd=ws).returncode == 0
-    assert (f"Invoking command in '{ws}/build/alpha': cmake {ws}/src/alpha -DCMAKE_INSTALL_PREFIX={ws}/install/alpha\n"
-            in _commands(ws, "alpha")), _commands(ws, "alpha")  # configured, as colcon logs it
+    root = ws.resolve()
+    configure = f"cmake {root}/src/alpha -DCMAKE_INSTALL_PREFIX={root}/install/alpha"
+    lines = _commands(ws, "alpha").splitlines()
+    assert lines[:2] == [f"Invoking command in '{root}/build/alpha': {configure}",
+                         f"Invoked command '{configure}' returned '0'"]
+    assert lines[-2:] == [f"Invoking command in '{root}/build/alpha': cmake --install {root}/build/alpha",
+                          f"Invoked command 'cmake --install {root}/build/alpha' returned '0'"]
     assert (ws / "build" / "alpha" / "cmake_args.last").read_text() == "None"
     assert roc("work", "build", "--force", cwd=ws).returncode == 0  # --force: build even if up to date
     assert "-DCMAKE_INSTALL_PREFIX" not in _commands(ws, "alpha")  # but no configure: nothing changed

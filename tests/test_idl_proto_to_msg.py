@@ -36,6 +36,7 @@ def constants(outputs: dict[str, str], relative: str) -> dict[str, tuple[str, ob
     return {c.name: (c.type, c.value) for c in spec(outputs, relative).constants}
 
 
+@pytest.mark.slow
 def test_every_output_passes_both_ros_parsers(outputs, tmp_path):
     write(outputs, tmp_path / "out")
     for relative in outputs:

@@ -27,7 +27,7 @@ from fixture_workspaces import (
 
 pytestmark = [
     pytest.mark.colcon,
-    pytest.mark.slow,
+    pytest.mark.slow,  # runs the real colcon
     pytest.mark.skipif(not colcon_available(), reason="the real colcon (the test oracle) is not installed"),
 ]
 

@@ -17,7 +17,6 @@ from powershell_parse import PARSER, applied, check_package_scripts, parse, stat
 from roc.environment.dsv import Operation
 from roc.shell.scripts import render
 
-pytestmark = pytest.mark.slow  # real builds or a PowerShell parser: see README's quick loop
 
 
 def test_the_parser_finds_errors():
@@ -53,6 +52,7 @@ def test_every_dsv_operation_kind():
     assert "if (-not [Environment]::GetEnvironmentVariable('RMW_IMPLEMENTATION')) { _roc_set" in text
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("merged", [False, True])
 def test_scripts_parse_and_match_their_sh_twins(tmp_path, merged):
     ws = copy_fixture("build_small", tmp_path / "ws")
@@ -81,6 +81,7 @@ def test_scripts_parse_and_match_their_sh_twins(tmp_path, merged):
         ("Join-Path", "$PSScriptRoot", "local_setup.ps1"), (".", "$_roc_setup_script")]
 
 
+@pytest.mark.slow
 def test_setup_ps1_chains_the_underlays(tmp_path):
     underlay = copy_fixture("build_small", tmp_path / "under lay")
     overlay = tmp_path / "overlay"

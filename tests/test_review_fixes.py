@@ -23,6 +23,7 @@ def _plain(ws, name: str, text: str = "v1", depends: str = "") -> None:
         f"install(FILES ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake DESTINATION share/{name}/cmake)\n")
 
 
+@pytest.mark.slow
 def test_generated_files_are_readable_by_others(tmp_path):
     _plain(tmp_path, "alpha")
     assert roc("work", "build", cwd=tmp_path).returncode == 0
@@ -30,6 +31,7 @@ def test_generated_files_are_readable_by_others(tmp_path):
         assert stat.S_IMODE(path.stat().st_mode) & 0o044 == 0o044, path
 
 
+@pytest.mark.slow
 def test_posix_sh_with_spaces_and_non_ascii_in_the_path(tmp_path):
     ws = tmp_path / "my wörk $space"
     _plain(ws, "alpha")
@@ -83,6 +85,7 @@ def test_unusable_package_name_is_an_error(tmp_path):
     assert not (tmp_path / "PWNED").exists() and not (tmp_path / "install").exists()
 
 
+@pytest.mark.slow
 def test_unsupported_build_type_is_skipped_with_a_warning(tmp_path):
     (tmp_path / "src" / "rusty").mkdir(parents=True)
     (tmp_path / "src" / "rusty" / "package.xml").write_text(
@@ -109,6 +112,7 @@ def test_bad_bases_and_numbers_are_one_line_errors(tmp_path, args, words):
     assert all(word in result.stderr for word in words), result.stderr
 
 
+@pytest.mark.slow
 def test_not_processed_packages_are_counted(tmp_path):
     _plain(tmp_path, "a")
     (tmp_path / "src" / "a" / "CMakeLists.txt").write_text("message(FATAL_ERROR no)\n")

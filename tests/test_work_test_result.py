@@ -56,7 +56,7 @@ def results(tmp_path: Path) -> Path:
     return tmp_path
 
 
-@pytest.mark.slow  # the colcon oracle
+@pytest.mark.slow  # runs the real colcon
 @pytest.mark.parametrize("options", [(), ("--all",), ("--verbose",), ("--all", "--verbose"),
                                      ("--result-files-only",), ("--result-files-only", "--all")])
 def test_output_equals_colcon(results: Path, options: tuple[str, ...]) -> None:
