@@ -120,8 +120,6 @@ def test_another_compiler_in_cc_makes_cmake_packages_stale(ws: Path, tmp_path: P
     assert _started(ws) == {name: tuple(r) for name, r in reasons.items()}
 
 
-@pytest.mark.xfail(strict=True, reason="known bug: the rebuild keeps CMakeCache's CMAKE_C_COMPILER (no reconfigure), "
-                                       "so the new CC never runs although the build is recorded as made with it")
 def test_a_rebuild_for_another_cc_compiles_with_it(ws: Path, tmp_path: Path) -> None:
     marker = tmp_path / "compiled-with-wrapper"
     compiler = tmp_path / "wrapped-cc"

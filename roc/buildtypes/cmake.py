@@ -1,19 +1,24 @@
 """cmake and ament_cmake packages: configure when needed, build, install.
 
 Configure runs only when there is no CMake cache, the arguments changed (``cmake_args.last``, as
-colcon keeps it) or it is forced. Switching ``--symlink-install`` on or off cleans what the other mode
+colcon keeps it) or it is forced; when the compilers or the build program changed, with a new cache. Switching ``--symlink-install`` on or off cleans what the other mode
 left (see ``switch_install_mode``). Makefile builds take part in roc's global jobserver.
 """
 
 from __future__ import annotations
 
+import json
+import os
 import re
 import shutil
 from pathlib import Path
 
+from roc.builder.fingerprint import build_tools
 from roc.buildtypes.context import BuildOptions, PackageJob
 from roc.engine.process import TaskContext, TaskError
 from roc.fsutil import write_text_atomic
+
+TOOLS_FILE = "roc_cmake_tools.last"  # the programs of the last configure (see _configure_tools)
 
 
 def cmake_arguments(job: PackageJob, options: BuildOptions) -> list[str]:
@@ -105,8 +110,12 @@ def build_cmake(context: TaskContext, job: PackageJob, options: BuildOptions) ->
     args = cmake_arguments(job, options)
     last_args = build_dir / "cmake_args.last"
     recorded = repr(args) if args else "None"
-    if options.cmake_clean_cache:
+    tools = _configure_tools(job, args)
+    last_tools = build_dir / TOOLS_FILE
+    if options.cmake_clean_cache or (last_tools.exists() and last_tools.read_text() != tools):
+        # A cache keeps the compilers and build program of its first configure: start a new one.
         (build_dir / "CMakeCache.txt").unlink(missing_ok=True)
+        shutil.rmtree(build_dir / "CMakeFiles", ignore_errors=True)
     if job.package.build_type == "ament_cmake":
         switch_install_mode(build_dir, job.prefix, options.symlink_install)
     needs_configure = (
@@ -119,6 +128,7 @@ def build_cmake(context: TaskContext, job: PackageJob, options: BuildOptions) ->
         command = ["cmake", str(job.source), *args, f"-DCMAKE_INSTALL_PREFIX={job.prefix}"]
         _check(context, job, command, "CMake configure")
         write_text_atomic(last_args, recorded)
+        write_text_atomic(last_tools, tools)
     targets = []
     if options.cmake_clean_first:
         targets.append("clean")
@@ -134,6 +144,18 @@ def build_cmake(context: TaskContext, job: PackageJob, options: BuildOptions) ->
         _check(context, job, _build_command(job, options, target), f"building target '{target or 'all'}'")
     if not options.cmake_target and _has_target(build_dir, "install"):
         _check(context, job, ["cmake", "--install", str(build_dir)], "install")
+
+
+def _configure_tools(job: PackageJob, args: list[str]) -> str:
+    """The programs a first configure records in CMakeCache.txt (compilers, the generator's build
+    program, as build_tools names them), resolved on the build's PATH: when they change, the package
+    is configured afresh so that the new ones are used."""
+    path = job.env.get("PATH")
+    found = {}
+    for tool in build_tools(job.package.build_type, job.env, tuple(args)):
+        location = shutil.which(tool, path=path)
+        found[tool] = os.path.realpath(location) if location else None
+    return json.dumps(found, sort_keys=True)
 
 
 def _build_command(job: PackageJob, options: BuildOptions, target: str) -> list[str]:
