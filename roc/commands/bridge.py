@@ -7,9 +7,8 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from roc.errors import UsageError
+from roc.fsutil import read_yaml
 from roc.render import json_line, print_text, table_lines
 
 QOS_KEYS = {"reliability", "durability", "history", "depth"}
@@ -41,13 +40,7 @@ def routes_from_config(path: Path):
     from_domain, to_domain, remap, qos}}``)."""
     from roc.ros.bridge import Route
 
-    try:
-        document = yaml.safe_load(path.read_text())
-    except OSError as error:
-        raise UsageError(f"{path}: cannot read it ({error.strerror})") from None
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        raise UsageError(f"{path}{f':{mark.line + 1}' if mark else ''}: not valid YAML") from None
+    document = read_yaml(path)
     if not isinstance(document, dict) or not isinstance(document.get("topics", {}), dict):
         raise UsageError(f"{path}: expected a mapping with 'topics: {{NAME: {{type: ...}}}}' as domain_bridge reads")
     if document.get("services") or document.get("actions"):

@@ -7,12 +7,11 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from roc.cli.options import add_graph_arguments
 from roc.commands.graph_common import ask
 from roc.commands.param_set import report, set_parameters, typed_value
 from roc.errors import UsageError
+from roc.fsutil import read_yaml
 from roc.messages import warn
 
 
@@ -36,14 +35,7 @@ def flattened(tree: dict[str, Any], prefix: str = "") -> dict[str, Any]:
 
 def file_parameters(path: Path, node: str) -> dict[str, Any]:
     """The parameters the file gives ``node`` (its own section over ``/**``)."""
-    try:
-        document = yaml.safe_load(path.read_text())
-    except OSError as error:
-        raise UsageError(f"{path}: cannot read it ({error.strerror})") from None
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f":{mark.line + 1}" if mark else ""
-        raise UsageError(f"{path}{where}: not valid YAML ({getattr(error, 'problem', error)})") from None
+    document = read_yaml(path)
     if not isinstance(document, dict):
         raise UsageError(f"{path}: expected a mapping of node names to {{ros__parameters: ...}}")
     values: dict[str, Any] = {}
