@@ -281,6 +281,17 @@ def _without_waiting(text: str) -> str:
                                                                             "WARNING: topic")))
 
 
+def _oracle(*command: str, env: dict[str, str]) -> subprocess.CompletedProcess:
+    """ros2's answer, asked up to three times: on a loaded machine ros2 sometimes says a topic "does not
+    appear to be published yet" that its own daemon lists (its flakiness is not what is compared here;
+    roc's answer is taken from its first try)."""
+    for _ in range(3):
+        result = ros2(*command, env=env)
+        if result.returncode == 0:
+            break
+    return result
+
+
 def test_the_ros2_cli_prints_the_same(graph) -> None:
     reason = install_oracle()
     if reason:
@@ -299,14 +310,15 @@ def test_the_ros2_cli_prints_the_same(graph) -> None:
         ("param", "set", "/motor", "max_speed", "1.75"),
     ]
     for command in commands:
-        ours, theirs = roc(*command, env=env), ros2(*command, env=env)
-        assert (ours.returncode, _without_waiting(ours.stdout)) == (theirs.returncode, _without_waiting(theirs.stdout)), command
+        ours, theirs = roc(*command, env=env), _oracle(*command, env=env)
+        assert (ours.returncode, _without_waiting(ours.stdout)) == (theirs.returncode, _without_waiting(theirs.stdout)), \
+            (command, ours.stderr, theirs.stderr)
     refused = ("param", "set", "/motor", "max_speed", "fast")  # ros2 exits 0 here; roc exits 1
     ours, theirs = roc(*refused, env=env), ros2(*refused, env=env)
     assert (ours.returncode, ours.stdout, ours.stderr) == (1, theirs.stdout, theirs.stderr)
     # (no -f: ros2 may print the first feedback before "Goal accepted", as its callbacks race)
     goal = ("action", "send_goal", "/fibonacci", "test_msgs/action/Fibonacci", "{order: 3}")
-    ours, theirs = roc(*goal, env=env), ros2(*goal, env=env)
+    ours, theirs = roc(*goal, env=env), _oracle(*goal, env=env)
     assert ours.returncode == theirs.returncode == 0, theirs.stderr
 
     def without_goal_id(text: str) -> str:
