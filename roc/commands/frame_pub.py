@@ -12,6 +12,7 @@ from roc.errors import UsageError
 from roc.frames.transform import Transform, normalized
 from roc.render import print_text
 from roc.ros.client import stream
+from roc.ros.types import TF_TYPE, message_class
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -48,9 +49,6 @@ def given(args: argparse.Namespace) -> Transform:
 def message(parent: str, child: str, transform: Transform):
     from geometry_msgs.msg import TransformStamped
 
-    from roc.frames.listen import TF_TYPE
-    from roc.ros.types import message_class
-
     stamped = TransformStamped()
     stamped.header.frame_id, stamped.child_frame_id = parent, child
     (stamped.transform.translation.x, stamped.transform.translation.y,
@@ -68,7 +66,7 @@ def _stamped(tf_message):
 
 
 def run(args: argparse.Namespace) -> int:
-    from roc.frames.listen import TF_TYPE, require_tf2_msgs
+    from roc.frames.listen import require_tf2_msgs
     from roc.ros.dataplane import encode, serialize
 
     require_tf2_msgs()

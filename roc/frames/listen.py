@@ -10,9 +10,7 @@ from roc.errors import UsageError
 from roc.frames.buffer import Buffer
 from roc.frames.transform import Transform
 from roc.ros.client import stream
-from roc.ros.types import UnknownTypeError, message_class
-
-TF_TYPE = "tf2_msgs/msg/TFMessage"
+from roc.ros.types import TF_TYPE, UnknownTypeError, message_class
 
 
 def require_tf2_msgs() -> None:

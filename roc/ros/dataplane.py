@@ -30,7 +30,7 @@ from rclpy.qos import (
 from rclpy.serialization import deserialize_message, serialize_message
 
 from roc.errors import RocError
-from roc.ros.types import message_class
+from roc.ros.types import TF_TYPE, message_class
 
 HEARTBEAT_SECONDS = 0.5
 MAX_BATCH = 1000  # messages in one ``messages`` event
@@ -254,9 +254,6 @@ def stats(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
     finally:
         for subscription in subscriptions:
             graph.node.destroy_subscription(subscription)
-
-
-TF_TYPE = "tf2_msgs/msg/TFMessage"
 
 
 def frames(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:

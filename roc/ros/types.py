@@ -23,6 +23,9 @@ KIND_NOUNS = {"msg": "message", "srv": "service", "action": "action"}
 DEFINITION_SUFFIXES = {"msg": ".msg", "srv": ".srv", "action": ".action"}
 
 
+TF_TYPE = "tf2_msgs/msg/TFMessage"  # what /tf and /tf_static carry
+
+
 class UnknownTypeError(UsageError):
     """An interface type that is not installed, or a malformed type name."""
 
