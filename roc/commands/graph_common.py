@@ -13,13 +13,21 @@ from typing import Any
 from roc.cli.options import add_graph_arguments
 from roc.errors import RocError
 from roc.render import render
-from roc.ros.client import query
+from roc.ros.client import DEFAULT_SPIN_TIME, query
 from roc.ros.present import is_hidden
 
 
 def ask(args: argparse.Namespace, method: str, params: dict[str, Any] | None = None) -> Any:
     """A graph request, through the daemon unless ``--no-daemon``."""
     return query(method, params, use_daemon=not args.no_daemon, spin_time=args.spin_time)
+
+
+def publisher_wait(args: argparse.Namespace) -> float:
+    """How long a stream waits for a topic's publishers to be discovered: nothing through the warm
+    daemon, the discovery period in a fresh participant."""
+    if args.spin_time is not None:
+        return args.spin_time
+    return DEFAULT_SPIN_TIME if args.no_daemon else 0.0
 
 
 def snapshot(args: argparse.Namespace, kind: str) -> list[dict[str, Any]]:

@@ -7,6 +7,7 @@ import base64
 import sys
 
 from roc.cli.options import add_graph_arguments, add_qos_arguments, qos_options
+from roc.commands.graph_common import publisher_wait
 from roc.errors import RocError, UsageError
 from roc.render import json_line, print_text
 from roc.ros.client import stream
@@ -75,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
     if qos["depth"] is None and args.qos_history != "keep_all":
         qos["depth"] = DEFAULT_DEPTH
     params = {"topic": args.topic_name, "type": args.message_type, "qos": qos,
-              "wait": args.spin_time if args.spin_time is not None else 3.5 if args.no_daemon else 0.0,
+              "wait": publisher_wait(args),
               "timeout": args.timeout}
     lost_total = 0
     type_name = args.message_type

@@ -9,6 +9,7 @@ import time
 from collections.abc import Callable
 
 from roc.cli.options import add_graph_arguments
+from roc.commands.graph_common import publisher_wait
 from roc.errors import UsageError
 from roc.render import print_json_line, print_text
 from roc.ros.client import stream
@@ -35,7 +36,7 @@ def watch(args: argparse.Namespace, measure: Measure, text: Text, *, stamps: boo
     if args.window < 2:
         raise UsageError(f"--window: must be at least 2, got {args.window}")
     windows = {topic: Window(args.window) for topic in topics}
-    wait = args.spin_time if args.spin_time is not None else 3.5 if args.no_daemon else 0.0
+    wait = publisher_wait(args)
     events = _filtered(args, topics[0], accept, wait) if accept else stream(
         "stats", {"topics": topics, "wait": wait, "stamps": stamps}, use_daemon=not args.no_daemon)
     reported_lost = dict.fromkeys(topics, 0)

@@ -23,6 +23,7 @@ from roc.errors import RocError
 # The variables that decide what a participant discovers: a daemon serves one set of values.
 DISCOVERY_VARIABLES = ("ROS_DOMAIN_ID", "RMW_IMPLEMENTATION", "ROS_AUTOMATIC_DISCOVERY_RANGE",
                        "ROS_STATIC_PEERS", "ROS_LOCALHOST_ONLY")
+DEFAULT_SPIN_TIME = 3.5  # daemon-less discovery (see roc.ros.graph)
 REQUEST_TIMEOUT = float(os.environ.get("ROC_DAEMON_TIMEOUT", "30"))
 START_TIMEOUT = 15.0
 
@@ -258,12 +259,11 @@ class Session:
     times, e.g. ``roc graph check``; thread-safe."""
 
     def __init__(self, use_daemon: bool = True, spin_time: float | None = None):
-        self.use_daemon = use_daemon
-        self.graph = None
+        self.graph = None  # None: through the daemon
         if use_daemon:
             start_daemon().close()
         else:
-            from roc.ros.graph import DEFAULT_SPIN_TIME, Graph
+            from roc.ros.graph import Graph
 
             self.graph = Graph()
             self.graph.wait_for_discovery(spin_time if spin_time is not None else DEFAULT_SPIN_TIME)
@@ -277,12 +277,9 @@ class Session:
         if self.graph is None:
             yield from stream(method, params, heartbeats=heartbeats)
             return
-        import contextlib
+        from roc.ros.streams import run_on
 
-        from roc.ros.streams import STREAMS
-
-        with contextlib.closing(STREAMS[method](self.graph, params)) as events:
-            yield from (event for event in events if heartbeats or event.get("event") != "heartbeat")
+        yield from (e for e in run_on(self.graph, method, params) if heartbeats or e.get("event") != "heartbeat")
 
     def close(self) -> None:
         if self.graph is not None:

@@ -22,14 +22,15 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from roc.errors import RocError
+from roc.ros.client import DEFAULT_SPIN_TIME
 
 # Without a daemon, discovery lasts one Fast DDS announcement period and a margin (3.5 s: measured on
 # localhost, processes keep appearing up to 3 s after a fresh participant starts, with gaps of almost
 # 2 s: a participant outside the initial peers' range is heard at its next periodic announcement,
 # so no shorter quiet period is complete), then until the graph has been quiet for QUIET_SECONDS and
-# every endpoint's node is known, at most EXTRA_SECONDS longer. ``--spin-time`` sets the period.
+# every endpoint's node is known, at most EXTRA_SECONDS longer. ``--spin-time`` sets the period
+# (DEFAULT_SPIN_TIME, in roc.ros.client so that verbs can read it without rclpy).
 QUIET_SECONDS = 0.3
-DEFAULT_SPIN_TIME = 3.5
 EXTRA_SECONDS = 1.0
 POLL_SECONDS = 0.05
 SERVICE_TIMEOUT = 5.0

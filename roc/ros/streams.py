@@ -13,6 +13,12 @@ from roc.ros.dataplane import echo, frames, publish, stats
 STREAMS = {"echo": echo, "publish": publish, "stats": stats, "call": call, "goal": goal, "frames": frames}
 
 
+def run_on(graph, method: str, params: dict[str, Any], **in_process: Any) -> Iterator[dict[str, Any]]:
+    """A stream on an existing Graph; its endpoint is destroyed when the caller stops iterating."""
+    with contextlib.closing(STREAMS[method](graph, params, **in_process)) as events:
+        yield from events
+
+
 def local_stream(method: str, params: dict[str, Any], node_name: str | None = None,
                  **in_process: Any) -> Iterator[dict[str, Any]]:
     """A stream without the daemon: its endpoint on a fresh participant of this process, on a node
@@ -21,7 +27,6 @@ def local_stream(method: str, params: dict[str, Any], node_name: str | None = No
 
     graph = Graph(node_name)
     try:
-        with contextlib.closing(STREAMS[method](graph, params, **in_process)) as events:
-            yield from events
+        yield from run_on(graph, method, params, **in_process)
     finally:
         graph.close()
