@@ -14,7 +14,7 @@ from roc.buildtypes.context import BuildOptions
 from roc.engine.events import TaskStarted
 from roc.errors import UsageError
 from roc.handlers import EVENT_HANDLERS, handler_switches
-from roc.handlers.logs import LogHandler, task_log_folder
+from roc.handlers.logs import LogHandler, new_log_directory, task_log_folder
 from roc.workspace.package import Package
 
 
@@ -162,3 +162,17 @@ def test_log_handler_writes_each_kind_in_its_folder_and_every_event(tmp_path: Pa
     assert files["p/stderr.log"] == "warn\n"
     assert [line.split('"')[3] for line in files["events.log"].splitlines()] == [
         "CommandStarted", "TaskOutput", "CommandEnded", "TaskOutput", "RunFinished"]
+
+
+def test_latest_links_follow_new_runs_but_leave_real_folders_alone(tmp_path: Path) -> None:
+    """As colcon: ``latest`` links move to each new run; a real folder by that name (a workspace copied
+    with its links followed) is kept and does not stop the build."""
+    first = new_log_directory(tmp_path)
+    assert os.readlink(tmp_path / "latest_build") == first.name
+    assert os.readlink(tmp_path / "latest") == "latest_build"
+    (tmp_path / "latest_build").unlink()
+    (tmp_path / "latest_build").mkdir()
+    second = new_log_directory(tmp_path)
+    assert second != first and (tmp_path / "latest_build").is_dir() and not (tmp_path / "latest_build").is_symlink()
+    assert os.readlink(tmp_path / "latest") == "latest_build"
+    assert not list(tmp_path.glob(".*.tmp"))

@@ -55,8 +55,12 @@ SAME_AS_ROS2 = [
 
 @pytest.mark.parametrize("command", SAME_AS_ROS2, ids=" ".join)
 def test_same_output_as_ros2(demo, command):
-    expected = ros2(*command, env=demo)
     got = roc(*command, env=demo)
+    expected = ros2(*command, env=demo)
+    for _ in range(2):  # under load ros2 may leave out a node whose parameter services answer late: ask again
+        if expected.stdout == got.stdout:
+            break
+        expected = ros2(*command, env=demo)
     assert got.returncode == expected.returncode == 0, got.stderr
     assert got.stdout.splitlines() == expected.stdout.splitlines()
 

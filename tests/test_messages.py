@@ -382,7 +382,7 @@ def test_unsourced_system_install_is_pointed_at(tmp_path: Path, monkeypatch: pyt
 def test_unsourced_install_is_pointed_at(tmp_path: Path) -> None:
     """A type built in the workspace but not sourced: the error says to source install/setup.bash."""
     workspace = tmp_path / "ws"
-    shutil.copytree(REPO / "workspaces" / "example", workspace)
+    shutil.copytree(REPO / "workspaces" / "example" / "src", workspace / "src")
     built = roc("work", "build", "--packages-select", "demo_interfaces", cwd=workspace)
     assert built.returncode == 0, built.stdout + built.stderr
     probe = ("import sys\nfrom roc.ros.types import resolve_type\nfrom roc.errors import RocError\n"

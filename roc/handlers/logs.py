@@ -49,6 +49,8 @@ def new_log_directory(log_base: Path, verb: str = "build") -> Path:
         write_text_atomic(log_base / "COLCON_IGNORE", "")
     for name, target in ((f"latest_{verb}", directory.name), ("latest", f"latest_{verb}")):
         link = log_base / name
+        if link.exists() and not link.is_symlink():
+            continue  # as colcon: a real file or folder by that name is left alone
         temporary = log_base / f".{name}.tmp"
         temporary.unlink(missing_ok=True)
         temporary.symlink_to(target)
