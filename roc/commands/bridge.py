@@ -27,6 +27,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --all: never topics matching one of these (default: /rosout, /parameter_events)")
     parser.add_argument("--format", choices=("text", "json"), default="text",
                         help="json: one status object per line")
+    add_zenoh_arguments(parser)
 
 
 def _domain(value: Any, where: str) -> int:
@@ -67,6 +68,8 @@ def routes_from_config(path: Path):
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.zenoh_listen or args.zenoh_connect or args.zenoh_config:
+        return run_zenoh(args)
     from roc.ros.bridge import DomainBridge, Route
 
     routes = routes_from_config(args.config) if args.config else []
@@ -95,4 +98,62 @@ def run(args: argparse.Namespace) -> int:
                            + "\n")
     finally:
         bridge.close()
+    return 0
+
+
+# ---- across networks on Zenoh (roc.ros.zenoh_link) -------------------------------------------------
+
+def add_zenoh_arguments(parser: argparse.ArgumentParser) -> None:
+    group = parser.add_argument_group("across networks on Zenoh (run one roc bridge on each side)")
+    group.add_argument("--zenoh-listen", action="append", default=[], metavar="ENDPOINT",
+                       help="accept Zenoh peers on this endpoint, e.g. tcp/0.0.0.0:7447")
+    group.add_argument("--zenoh-connect", action="append", default=[], metavar="ENDPOINT",
+                       help="connect to a Zenoh peer, e.g. tcp/robot.local:7447 (retried until it answers)")
+    group.add_argument("--zenoh-config", type=Path, metavar="FILE",
+                       help="a Zenoh JSON5 configuration (e.g. for TLS); the endpoints given are added to it")
+    group.add_argument("--domain", type=int, metavar="ID",
+                       help="the local ROS domain to carry topics from and to (default: ROS_DOMAIN_ID, else 0)")
+
+
+def run_zenoh(args: argparse.Namespace) -> int:
+    """Carry the selected topics between the local domain and the Zenoh peers, both ways, until Ctrl+C."""
+    import os
+    import sys
+
+    from roc.ros.zenoh_link import ZenohLink, zenoh_config
+
+    if args.from_domain is not None or args.to_domain is not None or args.config:
+        raise UsageError("--from-domain, --to-domain and --config bridge domains; across Zenoh give --domain")
+    if not args.topics and not args.all:
+        raise UsageError("nothing to bridge: name topics, or --all")
+    if not args.zenoh_listen and not args.zenoh_connect and args.zenoh_config is None:
+        raise UsageError("give --zenoh-listen ENDPOINT or --zenoh-connect ENDPOINT")
+    domain = args.domain if args.domain is not None else os.environ.get("ROS_DOMAIN_ID") or 0
+    try:
+        domain = _domain(int(domain), "--domain")
+    except ValueError:
+        raise UsageError(f"ROS_DOMAIN_ID: expected a ROS domain id (0 to 232), got {domain!r}") from None
+    config = zenoh_config(args.zenoh_listen, args.zenoh_connect, args.zenoh_config)
+    exclude = args.exclude or ["^/rosout$", "^/parameter_events$"]
+    link = ZenohLink(domain, [t if t.startswith("/") else f"/{t}" for t in args.topics], args.include, exclude, args.all, config)
+    try:
+        for event in link.run():
+            if args.format == "json":
+                print_text(json_line(event))
+            elif event["event"] == "bridging":
+                way = (f"domain {event['domain']} -> zenoh" if event["direction"] == "out"
+                       else f"zenoh -> domain {event['domain']}")
+                print_text(f"bridging {event['topic']} [{event['type']}] {way} "
+                           f"({event['reliability']}, {event['durability']})\n")
+            elif event["event"] == "session":
+                print_text(f"zenoh session {event['zid']} on domain {event['domain']}\n")
+            elif event["event"] == "peer":
+                print_text(f"zenoh peer {event['zid']} {'connected' if event['connected'] else 'gone'}\n")
+            elif event["event"] == "error":
+                print_text(f"roc: error: {event['message']}\n", sys.stderr)
+            elif event["rates"]:
+                print_text("\n".join(table_lines([[topic, f"{rate:.1f} msg/s"]
+                                                  for topic, rate in event["rates"].items()])) + "\n")
+    finally:
+        link.close()
     return 0

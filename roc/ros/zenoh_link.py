@@ -1,0 +1,275 @@
+"""A ROS domain joined to a Zenoh session: ``roc bridge --zenoh-listen/--zenoh-connect``.
+
+Two links (two processes, on two hosts or in two domains) connected over Zenoh carry the selected
+topics both ways, as serialised CDR (never deserialised). Each selected local topic that has a
+publisher other than a bridge's gets a raw subscription (QoS following its publishers, as the domain
+bridge does) whose messages are put on the Zenoh key ``roc/topic/NAME`` (``roc/latched/NAME`` for
+transient local topics). Every sample carries, as its Zenoh attachment, the topic's type, reliability,
+durability and depth, so the far side creates a publisher with the same name, type and QoS without
+guessing. A transient local topic's last ``depth`` messages stay in a Zenoh publication cache, which a
+far side that joins later queries (a Zenoh advanced subscriber with history), so latched messages
+reach it too. Topics are looked for again every second, so a publisher that appears later is picked up.
+
+No loops: the link forwards only topics with a publisher other than a bridge's (so a topic the link
+only republishes goes no further); the link's participant ignores its own endpoints (the Fast DDS
+profile of ``loop_guard``), so what it publishes never reaches its own subscriptions even when a
+topic has publishers on both sides; and its Zenoh subscribers take remote samples only, so a link
+never receives its own puts. The link never prints: ``run`` yields status events.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import queue
+import re
+import threading
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import zenoh
+import zenoh.ext
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
+from roc.errors import RocError, UsageError
+from roc.ros.bridge import BRIDGE_NODE
+from roc.ros.dataplane import qos_profile
+from roc.ros.graph import Graph
+from roc.ros.types import message_class
+
+SCAN_SECONDS = 1.0
+LINK_NODE = f"{BRIDGE_NODE}_zenoh"  # a bridge's node: domain bridges leave its topics alone too
+VOLATILE_PREFIX = "roc/topic"
+LATCHED_PREFIX = "roc/latched"
+IGNORE_LOCAL_PROFILE = Path(__file__).with_name("fastdds_ignore_local.xml")
+PROFILE_VARIABLES = ("FASTDDS_DEFAULT_PROFILES_FILE", "FASTRTPS_DEFAULT_PROFILES_FILE")
+
+
+IP_ENDPOINT = re.compile(r"(tcp|udp|tls|quic|ws)/(\[[0-9a-fA-F:.]+\]|[^/:?#\[\]]+):(\d{1,5})([?#].*)?")
+
+
+def _zenoh_message(error: Exception) -> str:
+    """Zenoh's error text without the Rust source locations and parser wrappers it adds."""
+    text = re.sub(r" at /\S+\.rs:\d+\.?", "", str(error)).strip()
+    quoted = re.search(r'msg: "(.*?)"', text)
+    return (quoted.group(1) if quoted else text).splitlines()[0]
+
+
+def _check_endpoint(option: str, endpoint: str) -> None:
+    """An IP endpoint needs a host and a port: Zenoh itself would only find out when it connects."""
+    protocol = endpoint.split("/", 1)[0]
+    match = IP_ENDPOINT.fullmatch(endpoint)
+    if protocol in ("tcp", "udp", "tls", "quic", "ws") and not (match and int(match.group(3)) <= 65535):
+        raise UsageError(f"{option} {endpoint}: expected {protocol}/HOST:PORT, e.g. {protocol}/127.0.0.1:7447")
+
+
+def zenoh_config(listen: list[str], connect: list[str], path: Path | None = None) -> zenoh.Config:
+    """A peer's configuration: ``path`` (a Zenoh JSON5 file, where TLS is configured) or defaults
+    without multicast scouting (the far side is named by an endpoint), plus the endpoints given, and
+    timestamps on (the publication caches of transient local topics need them)."""
+    if path is not None:
+        try:
+            config = zenoh.Config.from_file(str(path))
+        except zenoh.ZError as error:
+            raise UsageError(f"{path}: not a Zenoh configuration: {_zenoh_message(error)}") from None
+    else:
+        config = zenoh.Config()
+        config.insert_json5("scouting/multicast/enabled", "false")
+    config.insert_json5("timestamping/enabled", "true")
+    for option, key, endpoints in (("--zenoh-listen", "listen/endpoints", listen),
+                                   ("--zenoh-connect", "connect/endpoints", connect)):
+        for endpoint in endpoints:
+            _check_endpoint(option, endpoint)
+            try:  # one at a time, so that the error names the endpoint
+                config.insert_json5(key, json.dumps([endpoint]))
+            except zenoh.ZError as error:
+                raise UsageError(f"{option} {endpoint}: {_zenoh_message(error)} (e.g. tcp/127.0.0.1:7447)") from None
+        if endpoints:
+            config.insert_json5(key, json.dumps(endpoints))
+    return config
+
+
+def open_session(config: zenoh.Config) -> zenoh.Session:
+    try:
+        return zenoh.open(config)
+    except zenoh.ZError as error:
+        raise UsageError(f"cannot open the Zenoh session: {_zenoh_message(error)}") from None
+
+
+def loop_guard(environment: dict[str, str] = os.environ) -> None:
+    """Have Fast DDS keep the link's own publications from its subscriptions (rcl's
+    ``ignore_local_publications``, which rclpy cannot set), unless the user gave a profile of their own;
+    call it before the process creates any participant."""
+    if not any(environment.get(variable) for variable in PROFILE_VARIABLES):
+        environment["FASTDDS_DEFAULT_PROFILES_FILE"] = str(IGNORE_LOCAL_PROFILE)
+
+
+def _qos_names(profile: QoSProfile) -> tuple[str, str]:
+    return ("reliable" if profile.reliability == ReliabilityPolicy.RELIABLE else "best_effort",
+            "transient_local" if profile.durability == DurabilityPolicy.TRANSIENT_LOCAL else "volatile")
+
+
+@dataclass
+class _Topic:
+    """A topic the link carries one way: ``direction`` "out" (ROS to Zenoh) or "in" (Zenoh to ROS)."""
+
+    name: str
+    type: str
+    direction: str
+    endpoint: Any  # the raw subscription (out) or the publisher (in)
+    count: int = 0
+
+
+class ZenohLink:
+    def __init__(self, domain: int, topics: list[str], include: list[str] = (), exclude: list[str] = (),
+                 everything: bool = False, config: zenoh.Config | None = None) -> None:
+        """Carry ``topics`` (and with ``everything`` each topic whose name matches one of ``include``, all
+        when empty, and none of ``exclude``) between ROS domain ``domain`` and the Zenoh peers ``config``
+        names, both ways."""
+        self.domain = domain
+        self.topics = set(topics)
+        self.include = [re.compile(pattern) for pattern in include]
+        self.exclude = [re.compile(pattern) for pattern in exclude]
+        self.everything = everything
+        self.events: queue.SimpleQueue[dict[str, Any]] = queue.SimpleQueue()
+        self.outgoing: dict[str, _Topic] = {}
+        self.incoming: dict[str, _Topic] = {}
+        self.refused: set[str] = set()  # incoming topics whose type this side cannot load
+        self.lock = threading.Lock()
+        self.session = open_session(config or zenoh_config([], []))
+        self.graph = None
+        self.subscribers = []
+        try:
+            loop_guard()
+            self.graph = Graph(f"{LINK_NODE}_{domain}", domain_id=domain)
+            self.zid = str(self.session.zid())
+            self.subscribers = [
+                self.session.declare_subscriber(f"{VOLATILE_PREFIX}/**", self._received,
+                                                allowed_origin=zenoh.Locality.REMOTE),
+                zenoh.ext.declare_advanced_subscriber(
+                    self.session, f"{LATCHED_PREFIX}/**", self._received, allowed_origin=zenoh.Locality.REMOTE,
+                    history=zenoh.ext.HistoryConfig(detect_late_publishers=True))]
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self) -> None:
+        """Stop carrying: the Zenoh session closed, the rclpy context shut down."""
+        if not self.session.is_closed():
+            self.session.close()
+        if self.graph is not None:
+            self.graph.close()
+
+    def selected(self, topic: str) -> bool:
+        if topic in self.topics:
+            return True
+        return (self.everything and not any(p.search(topic) for p in self.exclude)
+                and (not self.include or any(p.search(topic) for p in self.include)))
+
+    # -- ROS to Zenoh -------------------------------------------------------------------------------
+    def _scan(self) -> None:
+        """Carry out each selected local topic that has a publisher other than a bridge's."""
+        node = self.graph.node
+        for name, types in node.get_topic_names_and_types():
+            if name in self.outgoing or not self.selected(name):
+                continue
+            publishers = [p for p in node.get_publishers_info_by_topic(name)
+                          if not p.node_name.startswith(BRIDGE_NODE)]
+            if publishers:
+                self._carry_out(name, types[0], publishers)
+
+    def _carry_out(self, name: str, type_name: str, publishers: list) -> None:
+        incoming = qos_profile({"profile": "default"}, publishers)
+        reliability, durability = _qos_names(incoming)
+        reliable = reliability == "reliable"
+        options = {"congestion_control": zenoh.CongestionControl.BLOCK if reliable else zenoh.CongestionControl.DROP,
+                   "reliability": zenoh.Reliability.RELIABLE if reliable else zenoh.Reliability.BEST_EFFORT}
+        if durability == "transient_local":
+            publisher = zenoh.ext.declare_advanced_publisher(
+                self.session, f"{LATCHED_PREFIX}{name}", cache=zenoh.ext.CacheConfig(incoming.depth),
+                publisher_detection=True, **options)
+        else:
+            publisher = self.session.declare_publisher(f"{VOLATILE_PREFIX}{name}", **options)
+        attachment = json.dumps({"type": type_name, "reliability": reliability, "durability": durability,
+                                 "depth": incoming.depth}).encode()
+        topic = _Topic(name, type_name, "out", None)
+
+        def forward(data: bytes) -> None:
+            publisher.put(data, attachment=attachment)
+            topic.count += 1
+        topic.endpoint = self.graph.node.create_subscription(message_class(type_name), name, forward, incoming,
+                                                             raw=True)
+        self.outgoing[name] = topic
+        self.events.put({"event": "bridging", "direction": "out", "topic": name, "type": type_name,
+                         "domain": self.domain, "reliability": reliability, "durability": durability})
+
+    # -- Zenoh to ROS -------------------------------------------------------------------------------
+    def _received(self, sample: zenoh.Sample) -> None:
+        """A remote sample (in a Zenoh thread): published in the local domain, the publisher created on
+        the topic's first sample with the type and QoS its attachment gives."""
+        key = str(sample.key_expr)
+        name = key[key.index("/", len("roc/")):]
+        topic = self.incoming.get(name)
+        if topic is None:
+            if name in self.refused or not self.selected(name) or sample.attachment is None:
+                return
+            with self.lock:
+                topic = self.incoming.get(name) or self._carry_in(name, json.loads(sample.attachment.to_bytes()))
+            if topic is None:
+                return
+        topic.endpoint.publish(sample.payload.to_bytes())
+        topic.count += 1
+
+    def _carry_in(self, name: str, header: dict[str, Any]) -> _Topic | None:
+        try:
+            cls = message_class(header["type"])
+        except RocError as error:
+            self.refused.add(name)
+            self.events.put({"event": "error", "message": f"{name}: cannot publish it here: {error}"})
+            return None
+        profile = QoSProfile(depth=header["depth"],
+                             reliability=ReliabilityPolicy.get_from_short_key(header["reliability"]),
+                             durability=DurabilityPolicy.get_from_short_key(header["durability"]))
+        topic = _Topic(name, header["type"], "in", self.graph.node.create_publisher(cls, name, profile))
+        self.incoming[name] = topic
+        self.events.put({"event": "bridging", "direction": "in", "topic": name, "type": header["type"],
+                         "domain": self.domain, "reliability": header["reliability"],
+                         "durability": header["durability"]})
+        return topic
+
+    # -- status -------------------------------------------------------------------------------------
+    def _peers(self) -> set[str]:
+        return {str(zid) for zid in self.session.info.peers_zid()}
+
+    def run(self, period: float = 1.0) -> Iterator[dict[str, Any]]:
+        """A ``session`` event, then ``peer`` events as Zenoh peers come and go, ``bridging`` events as
+        topics are carried out or in, ``error`` events, and a ``rates`` event every ``period`` seconds
+        (messages a second per topic and direction), until closed."""
+        yield {"event": "session", "zid": self.zid, "domain": self.domain}
+        peers: set[str] = set()
+        last, counts = time.monotonic(), {}
+        next_scan = 0.0
+        while True:
+            now = time.monotonic()
+            if now >= next_scan:
+                next_scan = now + SCAN_SECONDS
+                self._scan()
+                current = self._peers()
+                for zid in sorted(current ^ peers):
+                    yield {"event": "peer", "zid": zid, "connected": zid in current}
+                peers = current
+            while not self.events.empty():
+                yield self.events.get()
+            time.sleep(min(period, SCAN_SECONDS) / 4)
+            now = time.monotonic()
+            if now - last >= period:
+                rates = {}
+                for topic in [*self.outgoing.values(), *self.incoming.values()]:
+                    key = (topic.name, topic.direction)
+                    rates[f"{topic.name} ({topic.direction})"] = (topic.count - counts.get(key, 0)) / (now - last)
+                    counts[key] = topic.count
+                last = now
+                yield {"event": "rates", "rates": rates}
