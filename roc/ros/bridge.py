@@ -33,6 +33,7 @@ from roc.ros.graph import Graph
 from roc.ros.types import message_class
 
 SCAN_SECONDS = 1.0
+RECEIVE_DEPTH = 1000  # the subscription's queue: a burst waits rather than being dropped (0.8 % lost at 5 kHz with 10)
 BRIDGE_NODE = "_roc_bridge"
 IGNORE_LOCAL_PROFILE = Path(__file__).with_name("fastdds_ignore_local.xml")
 IGNORE_LOCAL_PROPERTY = "fastdds.ignore_local_endpoints"
@@ -133,7 +134,7 @@ class DomainBridge:
         self.everything = everything
         loop_guard(self.routes + ([Route("*", *everything)] if everything else []))
         domains = {d for r in self.routes for d in (r.from_domain, r.to_domain)} | set(everything or ())
-        self.graphs = {domain: Graph(f"{BRIDGE_NODE}_{domain}", domain_id=domain) for domain in sorted(domains)}
+        self.graphs = {domain: Graph(f"{BRIDGE_NODE}_{domain}", domain_id=domain, events=True) for domain in sorted(domains)}
         self.links: dict[tuple, _TopicLink | ServiceLink] = {}
 
     def close(self) -> None:
@@ -169,9 +170,11 @@ class DomainBridge:
         if not publishers or type_name is None:
             return None
         cls = message_class(type_name)
-        incoming = qos_profile({"profile": "default", **route.qos}, publishers)
-        outgoing = QoSProfile(depth=incoming.depth, history=incoming.history, reliability=incoming.reliability,
-                              durability=incoming.durability)
+        outgoing = qos_profile({"profile": "default", **route.qos}, publishers)
+        outgoing = QoSProfile(depth=outgoing.depth, history=outgoing.history, reliability=outgoing.reliability,
+                              durability=outgoing.durability)
+        incoming = QoSProfile(depth=max(outgoing.depth, RECEIVE_DEPTH), history=outgoing.history,
+                              reliability=outgoing.reliability, durability=outgoing.durability)
         publisher = self.graphs[route.to_domain].node.create_publisher(cls, route.target, outgoing)
         link = _TopicLink(route, type_name, None, publisher)
 
