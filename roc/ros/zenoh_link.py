@@ -20,7 +20,6 @@ never receives its own puts. The link never prints: ``run`` yields status events
 from __future__ import annotations
 
 import json
-import os
 import queue
 import re
 import threading
@@ -35,7 +34,7 @@ import zenoh.ext
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from roc.errors import RocError, UsageError
-from roc.ros.bridge import BRIDGE_NODE
+from roc.ros.bridge import BRIDGE_NODE, RECEIVE_DEPTH, Route, loop_guard, qos_name
 from roc.ros.dataplane import qos_profile
 from roc.ros.graph import Graph
 from roc.ros.types import message_class
@@ -44,8 +43,6 @@ SCAN_SECONDS = 1.0
 LINK_NODE = f"{BRIDGE_NODE}_zenoh"  # a bridge's node: domain bridges leave its topics alone too
 VOLATILE_PREFIX = "roc/topic"
 LATCHED_PREFIX = "roc/latched"
-IGNORE_LOCAL_PROFILE = Path(__file__).with_name("fastdds_ignore_local.xml")
-PROFILE_VARIABLES = ("FASTDDS_DEFAULT_PROFILES_FILE", "FASTRTPS_DEFAULT_PROFILES_FILE")
 
 
 IP_ENDPOINT = re.compile(r"(tcp|udp|tls|quic|ws)/(\[[0-9a-fA-F:.]+\]|[^/:?#\[\]]+):(\d{1,5})([?#].*)?")
@@ -99,19 +96,6 @@ def open_session(config: zenoh.Config) -> zenoh.Session:
         raise UsageError(f"cannot open the Zenoh session: {_zenoh_message(error)}") from None
 
 
-def loop_guard(environment: dict[str, str] = os.environ) -> None:
-    """Have Fast DDS keep the link's own publications from its subscriptions (rcl's
-    ``ignore_local_publications``, which rclpy cannot set), unless the user gave a profile of their own;
-    call it before the process creates any participant."""
-    if not any(environment.get(variable) for variable in PROFILE_VARIABLES):
-        environment["FASTDDS_DEFAULT_PROFILES_FILE"] = str(IGNORE_LOCAL_PROFILE)
-
-
-def _qos_names(profile: QoSProfile) -> tuple[str, str]:
-    return ("reliable" if profile.reliability == ReliabilityPolicy.RELIABLE else "best_effort",
-            "transient_local" if profile.durability == DurabilityPolicy.TRANSIENT_LOCAL else "volatile")
-
-
 @dataclass
 class _Topic:
     """A topic the link carries one way: ``direction`` "out" (ROS to Zenoh) or "in" (Zenoh to ROS)."""
@@ -143,8 +127,9 @@ class ZenohLink:
         self.graph = None
         self.subscribers = []
         try:
-            loop_guard()
-            self.graph = Graph(f"{LINK_NODE}_{domain}", domain_id=domain)
+            # every topic may have publishers on both sides, so the link may both publish and subscribe it
+            loop_guard([Route(name, domain, domain) for name in topics] + [Route("*", domain, domain)] * everything)
+            self.graph = Graph(f"{LINK_NODE}_{domain}", domain_id=domain, events=True)
             self.zid = str(self.session.zid())
             self.subscribers = [
                 self.session.declare_subscriber(f"{VOLATILE_PREFIX}/**", self._received,
@@ -182,19 +167,21 @@ class ZenohLink:
                 self._carry_out(name, types[0], publishers)
 
     def _carry_out(self, name: str, type_name: str, publishers: list) -> None:
-        incoming = qos_profile({"profile": "default"}, publishers)
-        reliability, durability = _qos_names(incoming)
+        offered = qos_profile({"profile": "default"}, publishers)
+        incoming = QoSProfile(depth=max(offered.depth, RECEIVE_DEPTH), history=offered.history,
+                              reliability=offered.reliability, durability=offered.durability)
+        reliability, durability = qos_name(incoming)
         reliable = reliability == "reliable"
         options = {"congestion_control": zenoh.CongestionControl.BLOCK if reliable else zenoh.CongestionControl.DROP,
                    "reliability": zenoh.Reliability.RELIABLE if reliable else zenoh.Reliability.BEST_EFFORT}
         if durability == "transient_local":
             publisher = zenoh.ext.declare_advanced_publisher(
-                self.session, f"{LATCHED_PREFIX}{name}", cache=zenoh.ext.CacheConfig(incoming.depth),
+                self.session, f"{LATCHED_PREFIX}{name}", cache=zenoh.ext.CacheConfig(offered.depth),
                 publisher_detection=True, **options)
         else:
             publisher = self.session.declare_publisher(f"{VOLATILE_PREFIX}{name}", **options)
         attachment = json.dumps({"type": type_name, "reliability": reliability, "durability": durability,
-                                 "depth": incoming.depth}).encode()
+                                 "depth": offered.depth}).encode()
         topic = _Topic(name, type_name, "out", None)
 
         def forward(data: bytes) -> None:
