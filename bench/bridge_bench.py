@@ -6,7 +6,10 @@ in domain 95 itself (the direct subscription) and one in domain 96 behind ``roc 
 at once. Prints messages received and lost by each, and the latency at the median and the 99th
 percentile, direct and bridged, and what the bridge adds.
 
-    python bench/bridge_bench.py [--rates 1000 5000] [--seconds 5]
+    python bench/bridge_bench.py [--rates 1000 5000] [--seconds 5] [--zenoh]
+
+``--zenoh``: through two ``roc bridge`` processes joined by Zenoh on localhost TCP instead (one with
+``--zenoh-listen`` in domain 95, one with ``--zenoh-connect`` in domain 96).
 
 Localhost discovery. Target (issue 15): no loss at 1 kHz, under 1 % at 5 kHz, added median latency
 under 1 ms. Every process shares the machine's cores (2 here), the publisher's and subscribers' too.
@@ -27,6 +30,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 ROC = Path(sys.executable).parent / "roc"
 SOURCE, TARGET = 95, 96
+ZENOH_PORT = 7495
 WAIT_SECONDS = 6.0  # the publisher waits this long: the bridge finds it, the subscribers match
 
 
@@ -53,16 +57,23 @@ def _result(path: Path) -> dict:
     return json.loads(lines[-1]) if lines else {"count": 0}
 
 
-def rate_run(rate: float, seconds: float, work: Path) -> dict:
+def _bridges(topic: str, zenoh: bool) -> list[tuple[list, int]]:
+    """The bridge processes' commands and ROS domains."""
+    if not zenoh:
+        return [([ROC, "bridge", "--from-domain", SOURCE, "--to-domain", TARGET, topic], SOURCE)]
+    endpoint = f"tcp/127.0.0.1:{ZENOH_PORT}"
+    return [([ROC, "bridge", "--zenoh-listen", endpoint, "--domain", SOURCE, topic], SOURCE),
+            ([ROC, "bridge", "--zenoh-connect", endpoint, "--domain", TARGET, topic], TARGET)]
+
+
+def rate_run(rate: float, seconds: float, work: Path, zenoh: bool = False) -> dict:
     topic = f"/bridged_{int(rate)}"
     subscriber = [sys.executable, HERE / "counting_subscriber.py", topic, "latency", "events"]
-    outputs = {name: work / f"{name}_{int(rate)}.txt" for name in ("publisher", "direct", "bridged", "bridge")}
-    processes = {
-        "bridge": _start([ROC, "bridge", "--from-domain", SOURCE, "--to-domain", TARGET, topic], SOURCE,
-                         outputs["bridge"]),
-        "direct": _start(subscriber, SOURCE, outputs["direct"]),
-        "bridged": _start(subscriber, TARGET, outputs["bridged"]),
-    }
+    outputs = {name: work / f"{name}_{int(rate)}.txt" for name in ("publisher", "direct", "bridged")}
+    processes = {f"bridge{i}": _start(command, domain, work / f"bridge{i}_{int(rate)}.txt")
+                 for i, (command, domain) in enumerate(_bridges(topic, zenoh))}
+    processes.update(direct=_start(subscriber, SOURCE, outputs["direct"]),
+                     bridged=_start(subscriber, TARGET, outputs["bridged"]))
     publisher = _start([sys.executable, HERE / "paced_publisher.py", topic, rate, seconds, WAIT_SECONDS, "stamped"],
                        SOURCE, outputs["publisher"])
     try:
@@ -78,14 +89,16 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rates", type=float, nargs="+", default=[1000, 5000])
     parser.add_argument("--seconds", type=float, default=5.0)
+    parser.add_argument("--zenoh", action="store_true", help="through two roc bridges joined by Zenoh")
     args = parser.parse_args()
     work = Path(tempfile.mkdtemp(prefix="roc-bridge-bench-"))
-    print(f"load average before: {os.getloadavg()[0]:.2f}")
+    print(f"through {'Zenoh (two roc bridge processes)' if args.zenoh else 'roc bridge (domain to domain)'}; "
+          f"load average before: {os.getloadavg()[0]:.2f}")
     print(f"{'rate':>6} {'sent':>7} | {'direct':>7} {'lost':>6} {'med ms':>7} {'p99 ms':>7} | "
           f"{'bridged':>7} {'lost':>6} {'med ms':>7} {'p99 ms':>7} | {'added med':>9} {'added p99':>9}")
     verdicts = []
     for rate in args.rates:
-        result = rate_run(rate, args.seconds, work)
+        result = rate_run(rate, args.seconds, work, args.zenoh)
         sent = result["publisher"].get("count", 0)
         direct, bridged = result["direct"], result["bridged"]
         loss = (sent - bridged["count"]) / sent if sent else 1.0

@@ -6,7 +6,9 @@ publisher other than a bridge's gets a raw subscription (QoS following its publi
 bridge does) whose messages are put on the Zenoh key ``roc/topic/NAME`` (``roc/latched/NAME`` for
 transient local topics). Every sample carries, as its Zenoh attachment, the topic's type, reliability,
 durability and depth, so the far side creates a publisher with the same name, type and QoS without
-guessing. A transient local topic's last ``depth`` messages stay in a Zenoh publication cache, which a
+guessing. The link also announces each topic it carries out with a Zenoh liveliness token
+(``roc/announce/ZID/NAME/-/TYPE/RELIABILITY/DURABILITY/DEPTH``: ``-`` is no ROS name), so the far side
+creates the publisher before the first message, and its subscribers have matched it by then. A transient local topic's last ``depth`` messages stay in a Zenoh publication cache, which a
 far side that joins later queries (a Zenoh advanced subscriber with history), so latched messages
 reach it too. Topics are looked for again every second, so a publisher that appears later is picked up.
 
@@ -43,6 +45,7 @@ SCAN_SECONDS = 1.0
 LINK_NODE = f"{BRIDGE_NODE}_zenoh"  # a bridge's node: domain bridges leave its topics alone too
 VOLATILE_PREFIX = "roc/topic"
 LATCHED_PREFIX = "roc/latched"
+ANNOUNCE_PREFIX = "roc/announce"
 
 
 IP_ENDPOINT = re.compile(r"(tcp|udp|tls|quic|ws)/(\[[0-9a-fA-F:.]+\]|[^/:?#\[\]]+):(\d{1,5})([?#].*)?")
@@ -96,6 +99,21 @@ def open_session(config: zenoh.Config) -> zenoh.Session:
         raise UsageError(f"cannot open the Zenoh session: {_zenoh_message(error)}") from None
 
 
+def _announcement(zid: str, name: str, header: dict[str, Any]) -> str:
+    return (f"{ANNOUNCE_PREFIX}/{zid}{name}/-/{header['type']}/{header['reliability']}/{header['durability']}/"
+            f"{header['depth']}")
+
+
+def _announced(key: str) -> tuple[str, str, dict[str, Any]]:
+    """The announcing link's zid, the topic and its header."""
+    parts = key.split("/")
+    separator = parts.index("-", 3)
+    package, kind, type_name, reliability, durability, depth = parts[separator + 1:]
+    return parts[2], "/" + "/".join(parts[3:separator]), {
+        "type": f"{package}/{kind}/{type_name}", "reliability": reliability, "durability": durability,
+        "depth": int(depth)}
+
+
 @dataclass
 class _Topic:
     """A topic the link carries one way: ``direction`` "out" (ROS to Zenoh) or "in" (Zenoh to ROS)."""
@@ -121,11 +139,12 @@ class ZenohLink:
         self.events: queue.SimpleQueue[dict[str, Any]] = queue.SimpleQueue()
         self.outgoing: dict[str, _Topic] = {}
         self.incoming: dict[str, _Topic] = {}
-        self.refused: set[str] = set()  # incoming topics whose type this side cannot load
+        self.ignored: set[str] = set()  # remote topics not selected, or whose type this side cannot load
         self.lock = threading.Lock()
         self.session = open_session(config or zenoh_config([], []))
         self.graph = None
         self.subscribers = []
+        self.tokens = []
         try:
             # every topic may have publishers on both sides, so the link may both publish and subscribe it
             loop_guard([Route(name, domain, domain) for name in topics] + [Route("*", domain, domain)] * everything)
@@ -136,7 +155,8 @@ class ZenohLink:
                                                 allowed_origin=zenoh.Locality.REMOTE),
                 zenoh.ext.declare_advanced_subscriber(
                     self.session, f"{LATCHED_PREFIX}/**", self._received, allowed_origin=zenoh.Locality.REMOTE,
-                    history=zenoh.ext.HistoryConfig(detect_late_publishers=True))]
+                    history=zenoh.ext.HistoryConfig(detect_late_publishers=True)),
+                self.session.liveliness().declare_subscriber(f"{ANNOUNCE_PREFIX}/**", self._announced, history=True)]
         except BaseException:
             self.close()
             raise
@@ -180,8 +200,8 @@ class ZenohLink:
                 publisher_detection=True, **options)
         else:
             publisher = self.session.declare_publisher(f"{VOLATILE_PREFIX}{name}", **options)
-        attachment = json.dumps({"type": type_name, "reliability": reliability, "durability": durability,
-                                 "depth": offered.depth}).encode()
+        header = {"type": type_name, "reliability": reliability, "durability": durability, "depth": offered.depth}
+        attachment = json.dumps(header).encode()
         topic = _Topic(name, type_name, "out", None)
 
         def forward(data: bytes) -> None:
@@ -190,31 +210,45 @@ class ZenohLink:
         topic.endpoint = self.graph.node.create_subscription(message_class(type_name), name, forward, incoming,
                                                              raw=True)
         self.outgoing[name] = topic
+        self.tokens.append(self.session.liveliness().declare_token(_announcement(self.zid, name, header)))
         self.events.put({"event": "bridging", "direction": "out", "topic": name, "type": type_name,
                          "domain": self.domain, "reliability": reliability, "durability": durability})
 
     # -- Zenoh to ROS -------------------------------------------------------------------------------
     def _received(self, sample: zenoh.Sample) -> None:
-        """A remote sample (in a Zenoh thread): published in the local domain, the publisher created on
-        the topic's first sample with the type and QoS its attachment gives."""
+        """A remote sample (in a Zenoh thread): published in the local domain (the publisher created
+        with the type and QoS its attachment gives, if the announcement has not come first)."""
         key = str(sample.key_expr)
         name = key[key.index("/", len("roc/")):]
         topic = self.incoming.get(name)
-        if topic is None:
-            if name in self.refused or not self.selected(name) or sample.attachment is None:
-                return
-            with self.lock:
-                topic = self.incoming.get(name) or self._carry_in(name, json.loads(sample.attachment.to_bytes()))
-            if topic is None:
-                return
-        topic.endpoint.publish(sample.payload.to_bytes())
-        topic.count += 1
+        if topic is None and sample.attachment is not None:
+            topic = self._carry_in(name, json.loads(sample.attachment.to_bytes()))
+        if topic is not None:
+            topic.endpoint.publish(sample.payload.to_bytes())
+            topic.count += 1
+
+    def _announced(self, sample: zenoh.Sample) -> None:
+        """A link's announcement of a topic it carries (in a Zenoh thread): the publisher made ready."""
+        zid, name, header = _announced(str(sample.key_expr))
+        if sample.kind == zenoh.SampleKind.PUT and zid != self.zid:
+            self._carry_in(name, header)
 
     def _carry_in(self, name: str, header: dict[str, Any]) -> _Topic | None:
+        """The local publisher of a selected remote topic (None if not selected or its type is unknown
+        here), created with the header's type and QoS once."""
+        with self.lock:
+            if name in self.incoming or name in self.ignored:
+                return self.incoming.get(name)
+            if not self.selected(name):
+                self.ignored.add(name)
+                return None
+            return self._publisher_for(name, header)
+
+    def _publisher_for(self, name: str, header: dict[str, Any]) -> _Topic | None:
         try:
             cls = message_class(header["type"])
         except RocError as error:
-            self.refused.add(name)
+            self.ignored.add(name)
             self.events.put({"event": "error", "message": f"{name}: cannot publish it here: {error}"})
             return None
         profile = QoSProfile(depth=header["depth"],
