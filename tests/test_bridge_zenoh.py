@@ -167,3 +167,12 @@ def test_a_busy_listen_port_is_one_line(tmp_path: Path) -> None:
     assert result.returncode == 2, result.stderr
     assert result.stderr.startswith(f"roc: error: cannot open the Zenoh session: Can not create a new TCP listener "
                                     f"bound to {endpoint}"), result.stderr
+
+
+def test_an_announcement_key_gives_back_the_topic_and_its_header() -> None:
+    from roc.ros.zenoh_link import _announced, _announcement
+
+    header = {"type": "sensor_msgs/msg/Image", "reliability": "best_effort", "durability": "volatile", "depth": 5}
+    key = _announcement("a514b943", "/robot_1/camera/image", header)
+    assert key == "roc/announce/a514b943/robot_1/camera/image/-/sensor_msgs/msg/Image/best_effort/volatile/5"
+    assert _announced(key) == ("a514b943", "/robot_1/camera/image", header)

@@ -201,7 +201,7 @@ class ZenohLink:
         else:
             publisher = self.session.declare_publisher(f"{VOLATILE_PREFIX}{name}", **options)
         header = {"type": type_name, "reliability": reliability, "durability": durability, "depth": offered.depth}
-        attachment = json.dumps(header).encode()
+        attachment = zenoh.ZBytes(json.dumps(header).encode())
         topic = _Topic(name, type_name, "out", None)
 
         def forward(data: bytes) -> None:
