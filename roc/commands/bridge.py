@@ -190,11 +190,11 @@ def run_zenoh(args: argparse.Namespace) -> int:
 
     from roc.ros.zenoh_link import ZenohLink, zenoh_config
 
-    if args.from_domain is not None or args.to_domain is not None or args.config or args.service or args.action:
-        raise UsageError("--from-domain, --to-domain, --config, --service and --action bridge domains; "
-                         "across Zenoh give --domain and topics or --all")
-    if not args.topics and not args.all:
-        raise UsageError("nothing to bridge: name topics, or --all")
+    if args.from_domain is not None or args.to_domain is not None or args.config or args.action:
+        raise UsageError("--from-domain, --to-domain, --config and --action bridge domains; "
+                         "across Zenoh give --domain and topics, --all or --service")
+    if not args.topics and not args.all and not args.service:
+        raise UsageError("nothing to bridge: name topics, --all or --service")
     if not args.zenoh_listen and not args.zenoh_connect and args.zenoh_config is None:
         raise UsageError("give --zenoh-listen ENDPOINT or --zenoh-connect ENDPOINT")
     domain = args.domain if args.domain is not None else os.environ.get("ROS_DOMAIN_ID") or 0
@@ -204,7 +204,8 @@ def run_zenoh(args: argparse.Namespace) -> int:
         raise UsageError(f"ROS_DOMAIN_ID: expected a ROS domain id (0 to 232), got {domain!r}") from None
     config = zenoh_config(args.zenoh_listen, args.zenoh_connect, args.zenoh_config)
     exclude = args.exclude or ["^/rosout$", "^/parameter_events$"]
-    link = ZenohLink(domain, [_absolute(t) for t in args.topics], args.include, exclude, args.all, config)
+    link = ZenohLink(domain, [_absolute(t) for t in args.topics], args.include, exclude, args.all, config,
+                     [_absolute(s) for s in args.service])
     try:
         for event in link.run():
             if args.format == "json":
@@ -212,8 +213,9 @@ def run_zenoh(args: argparse.Namespace) -> int:
             elif event["event"] == "bridging":
                 way = (f"domain {event['domain']} -> zenoh" if event["direction"] == "out"
                        else f"zenoh -> domain {event['domain']}")
-                print_text(f"bridging {event['topic']} [{event['type']}] {way} "
-                           f"({event['reliability']}, {event['durability']})\n")
+                qos = f" ({event['reliability']}, {event['durability']})" if event["kind"] == "topic" else ""
+                kind = "" if event["kind"] == "topic" else "service "
+                print_text(f"bridging {kind}{event['topic']} [{event['type']}] {way}{qos}\n")
             elif event["event"] == "session":
                 print_text(f"zenoh session {event['zid']} on domain {event['domain']}\n")
             elif event["event"] == "peer":

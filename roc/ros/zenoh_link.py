@@ -26,6 +26,7 @@ import queue
 import re
 import threading
 import time
+from collections import deque
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,6 +41,7 @@ from roc.ros.bridge import BRIDGE_NODE, RECEIVE_DEPTH, Route, loop_guard, qos_na
 from roc.ros.dataplane import qos_profile
 from roc.ros.graph import Graph
 from roc.ros.types import message_class
+from roc.ros.zenoh_services import ServiceOffer, ServiceProxy
 
 SCAN_SECONDS = 1.0
 LINK_NODE = f"{BRIDGE_NODE}_zenoh"  # a bridge's node: domain bridges leave its topics alone too
@@ -100,18 +102,20 @@ def open_session(config: zenoh.Config) -> zenoh.Session:
 
 
 def _announcement(zid: str, name: str, header: dict[str, Any]) -> str:
-    return (f"{ANNOUNCE_PREFIX}/{zid}{name}/-/{header['type']}/{header['reliability']}/{header['durability']}/"
-            f"{header['depth']}")
+    """A topic's (type and QoS) or a service's (type only) announcement key."""
+    qos = [header["reliability"], header["durability"], str(header["depth"])] if "depth" in header else []
+    return "/".join([f"{ANNOUNCE_PREFIX}/{zid}{name}", "-", header["type"], *qos])
 
 
 def _announced(key: str) -> tuple[str, str, dict[str, Any]]:
-    """The announcing link's zid, the topic and its header."""
+    """The announcing link's zid, the topic or service and its header."""
     parts = key.split("/")
     separator = parts.index("-", 3)
-    package, kind, type_name, reliability, durability, depth = parts[separator + 1:]
-    return parts[2], "/" + "/".join(parts[3:separator]), {
-        "type": f"{package}/{kind}/{type_name}", "reliability": reliability, "durability": durability,
-        "depth": int(depth)}
+    package, kind, type_name, *qos = parts[separator + 1:]
+    header: dict[str, Any] = {"type": f"{package}/{kind}/{type_name}"}
+    if qos:
+        header.update(reliability=qos[0], durability=qos[1], depth=int(qos[2]))
+    return parts[2], "/" + "/".join(parts[3:separator]), header
 
 
 @dataclass
@@ -127,10 +131,10 @@ class _Topic:
 
 class ZenohLink:
     def __init__(self, domain: int, topics: list[str], include: list[str] = (), exclude: list[str] = (),
-                 everything: bool = False, config: zenoh.Config | None = None) -> None:
+                 everything: bool = False, config: zenoh.Config | None = None, services: list[str] = ()) -> None:
         """Carry ``topics`` (and with ``everything`` each topic whose name matches one of ``include``, all
-        when empty, and none of ``exclude``) between ROS domain ``domain`` and the Zenoh peers ``config``
-        names, both ways."""
+        when empty, and none of ``exclude``) and ``services`` between ROS domain ``domain`` and the Zenoh
+        peers ``config`` names, both ways (a service is offered by the side with its server)."""
         self.domain = domain
         self.topics = set(topics)
         self.include = [re.compile(pattern) for pattern in include]
@@ -139,6 +143,10 @@ class ZenohLink:
         self.events: queue.SimpleQueue[dict[str, Any]] = queue.SimpleQueue()
         self.outgoing: dict[str, _Topic] = {}
         self.incoming: dict[str, _Topic] = {}
+        self.services = set(services)
+        self.offers: dict[str, ServiceOffer] = {}
+        self.proxies: dict[str, ServiceProxy] = {}
+        self.errors: deque[str] = deque()
         self.ignored: set[str] = set()  # remote topics not selected, or whose type this side cannot load
         self.lock = threading.Lock()
         self.session = open_session(config or zenoh_config([], []))
@@ -163,6 +171,8 @@ class ZenohLink:
 
     def close(self) -> None:
         """Stop carrying: the Zenoh session closed, the rclpy context shut down."""
+        for service in [*self.offers.values(), *self.proxies.values()]:
+            service.close()
         if not self.session.is_closed():
             self.session.close()
         if self.graph is not None:
@@ -185,6 +195,18 @@ class ZenohLink:
                           if not p.node_name.startswith(BRIDGE_NODE)]
             if publishers:
                 self._carry_out(name, types[0], publishers)
+        service_types = dict(node.get_service_names_and_types())
+        for name in sorted(self.services - set(self.offers) - set(self.proxies)):
+            servers = [n for n, ns in node.get_node_names_and_namespaces() if not n.startswith(BRIDGE_NODE)
+                       and any(s == name for s, _ in node.get_service_names_and_types_by_node(n, ns))]
+            if servers and name in service_types:
+                type_name = service_types[name][0]
+                with self.lock:
+                    self.offers[name] = ServiceOffer(self.session, self.graph, name, type_name, self.errors)
+                self.tokens.append(self.session.liveliness().declare_token(
+                    _announcement(self.zid, name, {"type": type_name})))
+                self.events.put({"event": "bridging", "kind": "service", "direction": "out", "topic": name,
+                                 "type": type_name, "domain": self.domain})
 
     def _carry_out(self, name: str, type_name: str, publishers: list) -> None:
         offered = qos_profile({"profile": "default"}, publishers)
@@ -211,7 +233,7 @@ class ZenohLink:
                                                              raw=True)
         self.outgoing[name] = topic
         self.tokens.append(self.session.liveliness().declare_token(_announcement(self.zid, name, header)))
-        self.events.put({"event": "bridging", "direction": "out", "topic": name, "type": type_name,
+        self.events.put({"event": "bridging", "kind": "topic", "direction": "out", "topic": name, "type": type_name,
                          "domain": self.domain, "reliability": reliability, "durability": durability})
 
     # -- Zenoh to ROS -------------------------------------------------------------------------------
@@ -230,8 +252,26 @@ class ZenohLink:
     def _announced(self, sample: zenoh.Sample) -> None:
         """A link's announcement of a topic it carries (in a Zenoh thread): the publisher made ready."""
         zid, name, header = _announced(str(sample.key_expr))
-        if sample.kind == zenoh.SampleKind.PUT and zid != self.zid:
+        if sample.kind != zenoh.SampleKind.PUT or zid == self.zid:
+            return
+        if "depth" in header:
             self._carry_in(name, header)
+        elif name in self.services:
+            self._serve_in(name, header["type"])
+
+    def _serve_in(self, name: str, type_name: str) -> None:
+        """Serve a far side's service in the local domain (once)."""
+        with self.lock:
+            if name in self.proxies or name in self.offers:
+                return
+            try:
+                self.proxies[name] = ServiceProxy(self.session, self.graph, name, type_name,
+                                                  f"{LINK_NODE}_{self.domain}_service_{len(self.proxies)}", self.errors)
+            except RocError as error:
+                self.errors.append(f"{name}: cannot serve it here: {error}")
+                return
+        self.events.put({"event": "bridging", "kind": "service", "direction": "in", "topic": name,
+                         "type": type_name, "domain": self.domain})
 
     def _carry_in(self, name: str, header: dict[str, Any]) -> _Topic | None:
         """The local publisher of a selected remote topic (None if not selected or its type is unknown
@@ -256,7 +296,7 @@ class ZenohLink:
                              durability=DurabilityPolicy.get_from_short_key(header["durability"]))
         topic = _Topic(name, header["type"], "in", self.graph.node.create_publisher(cls, name, profile))
         self.incoming[name] = topic
-        self.events.put({"event": "bridging", "direction": "in", "topic": name, "type": header["type"],
+        self.events.put({"event": "bridging", "kind": "topic", "direction": "in", "topic": name, "type": header["type"],
                          "domain": self.domain, "reliability": header["reliability"],
                          "durability": header["durability"]})
         return topic
@@ -268,7 +308,7 @@ class ZenohLink:
     def run(self, period: float = 1.0) -> Iterator[dict[str, Any]]:
         """A ``session`` event, then ``peer`` events as Zenoh peers come and go, ``bridging`` events as
         topics are carried out or in, ``error`` events, and a ``rates`` event every ``period`` seconds
-        (messages a second per topic and direction), until closed."""
+        (messages or calls a second per topic or service and direction), until closed."""
         yield {"event": "session", "zid": self.zid, "domain": self.domain}
         peers: set[str] = set()
         last, counts = time.monotonic(), {}
@@ -284,13 +324,17 @@ class ZenohLink:
                 peers = current
             while not self.events.empty():
                 yield self.events.get()
+            while self.errors:
+                yield {"event": "error", "message": self.errors.popleft()}
             time.sleep(min(period, SCAN_SECONDS) / 4)
             now = time.monotonic()
             if now - last >= period:
                 rates = {}
-                for topic in [*self.outgoing.values(), *self.incoming.values()]:
-                    key = (topic.name, topic.direction)
-                    rates[f"{topic.name} ({topic.direction})"] = (topic.count - counts.get(key, 0)) / (now - last)
-                    counts[key] = topic.count
+                carried = [(f"{t.name} ({t.direction})", t) for t in [*self.outgoing.values(), *self.incoming.values()]]
+                carried += [(f"service {s.name} ({way})", s) for way, services in (("out", self.offers), ("in", self.proxies))
+                            for s in services.values()]
+                for key, counted in carried:
+                    rates[key] = (counted.count - counts.get(key, 0)) / (now - last)
+                    counts[key] = counted.count
                 last = now
                 yield {"event": "rates", "rates": rates}
