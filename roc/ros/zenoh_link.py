@@ -8,9 +8,12 @@ transient local topics). Every sample carries, as its Zenoh attachment, the topi
 durability and depth, so the far side creates a publisher with the same name, type and QoS without
 guessing. The link also announces each topic it carries out with a Zenoh liveliness token
 (``roc/announce/ZID/NAME/-/TYPE/RELIABILITY/DURABILITY/DEPTH``: ``-`` is no ROS name), so the far side
-creates the publisher before the first message, and its subscribers have matched it by then. A transient local topic's last ``depth`` messages stay in a Zenoh publication cache, which a
-far side that joins later queries (a Zenoh advanced subscriber with history), so latched messages
-reach it too. Topics are looked for again every second, so a publisher that appears later is picked up.
+creates the publisher before the first message, and its subscribers have matched it by then. A
+transient local topic's last ``depth`` messages stay in a Zenoh publication cache, which a far side
+that joins later queries (a Zenoh advanced subscriber with history), so latched messages reach it too.
+Topics are looked for again every second, so a publisher that appears later is picked up. Services
+named on both sides are offered by the side with the server (roc.ros.zenoh_services), announced the
+same way (``roc/announce/ZID/NAME/-/TYPE``).
 
 No loops: the link forwards only topics with a publisher other than a bridge's (so a topic the link
 only republishes goes no further); the link's participant ignores its own endpoints (the Fast DDS
@@ -48,8 +51,6 @@ LINK_NODE = f"{BRIDGE_NODE}_zenoh"  # a bridge's node: domain bridges leave its 
 VOLATILE_PREFIX = "roc/topic"
 LATCHED_PREFIX = "roc/latched"
 ANNOUNCE_PREFIX = "roc/announce"
-
-
 IP_ENDPOINT = re.compile(r"(tcp|udp|tls|quic|ws)/(\[[0-9a-fA-F:.]+\]|[^/:?#\[\]]+):(\d{1,5})([?#].*)?")
 
 
@@ -171,12 +172,14 @@ class ZenohLink:
 
     def close(self) -> None:
         """Stop carrying: the Zenoh session closed, the rclpy context shut down."""
+        for subscriber in self.subscribers:  # nothing more comes in
+            subscriber.undeclare()
         for service in [*self.offers.values(), *self.proxies.values()]:
             service.close()
-        if not self.session.is_closed():
-            self.session.close()
         if self.graph is not None:
             self.graph.close()
+        if not self.session.is_closed():
+            self.session.close()
 
     def selected(self, topic: str) -> bool:
         if topic in self.topics:
@@ -233,8 +236,9 @@ class ZenohLink:
                                                              raw=True)
         self.outgoing[name] = topic
         self.tokens.append(self.session.liveliness().declare_token(_announcement(self.zid, name, header)))
-        self.events.put({"event": "bridging", "kind": "topic", "direction": "out", "topic": name, "type": type_name,
-                         "domain": self.domain, "reliability": reliability, "durability": durability})
+        self.events.put({"event": "bridging", "kind": "topic", "direction": "out", "topic": name,
+                         "type": type_name, "domain": self.domain, "reliability": reliability,
+                         "durability": durability})
 
     # -- Zenoh to ROS -------------------------------------------------------------------------------
     def _received(self, sample: zenoh.Sample) -> None:
@@ -289,15 +293,15 @@ class ZenohLink:
             cls = message_class(header["type"])
         except RocError as error:
             self.ignored.add(name)
-            self.events.put({"event": "error", "message": f"{name}: cannot publish it here: {error}"})
+            self.errors.append(f"{name}: cannot publish it here: {error}")
             return None
         profile = QoSProfile(depth=header["depth"],
                              reliability=ReliabilityPolicy.get_from_short_key(header["reliability"]),
                              durability=DurabilityPolicy.get_from_short_key(header["durability"]))
         topic = _Topic(name, header["type"], "in", self.graph.node.create_publisher(cls, name, profile))
         self.incoming[name] = topic
-        self.events.put({"event": "bridging", "kind": "topic", "direction": "in", "topic": name, "type": header["type"],
-                         "domain": self.domain, "reliability": header["reliability"],
+        self.events.put({"event": "bridging", "kind": "topic", "direction": "in", "topic": name,
+                         "type": header["type"], "domain": self.domain, "reliability": header["reliability"],
                          "durability": header["durability"]})
         return topic
 
@@ -330,9 +334,10 @@ class ZenohLink:
             now = time.monotonic()
             if now - last >= period:
                 rates = {}
-                carried = [(f"{t.name} ({t.direction})", t) for t in [*self.outgoing.values(), *self.incoming.values()]]
-                carried += [(f"service {s.name} ({way})", s) for way, services in (("out", self.offers), ("in", self.proxies))
-                            for s in services.values()]
+                carried = [(f"{t.name} ({t.direction})", t)
+                           for t in [*self.outgoing.values(), *self.incoming.values()]]
+                carried += [(f"service {s.name} ({way})", s) for way, services
+                            in (("out", self.offers), ("in", self.proxies)) for s in services.values()]
                 for key, counted in carried:
                     rates[key] = (counted.count - counts.get(key, 0)) / (now - last)
                     counts[key] = counted.count
