@@ -77,27 +77,36 @@ def _first_messages(process: subprocess.Popen, seconds: float = 40) -> dict[str,
 
 
 @pytest.mark.slow
-def test_topics_arrive_intact_with_their_names_types_and_qos_and_a_service_answers(tmp_path: Path) -> None:
+def test_topics_arrive_intact_with_their_names_types_and_qos_and_a_service_and_an_action_answer(tmp_path: Path) -> None:
     a = graph_env(120, tmp_path / "a")
     b = {**a, "ROS_DOMAIN_ID": ros_domain_id(125)}
     endpoint = f"tcp/127.0.0.1:{_free_port()}"
     talker = start_nodes([[{"name": "talker", "publishers": [
         {"topic": topic, "type": type_name, "values": values, **qos, **({} if topic == "latched" else {"rate_hz": 10})}
         for topic, type_name, values, qos in PUBLISHED],
-        "services": [{"name": "echo_types", "type": "test_msgs/srv/BasicTypes", "echo": True}]}]], a)
+        "services": [{"name": "echo_types", "type": "test_msgs/srv/BasicTypes", "echo": True}],
+        "actions": [{"name": "fibonacci", "step_seconds": 0.05}]}]], a)
     processes, links = list(talker), []
     try:
-        links.append(_link(a, f"--zenoh-listen {endpoint}", "--all", "--service", "/echo_types"))
+        links.append(_link(a, f"--zenoh-listen {endpoint}", "--all", "--service", "/echo_types",
+                           "--action", "fibonacci"))
         out = _events_until(links[0], _carried("out", {f"/{topic}" for topic, *_ in PUBLISHED} | {"/echo_types"}))
         # the far side joins after the latched message went out: it reaches it from the publication cache
         links.append(_link(b, f"--zenoh-connect {endpoint}", *(f"/{topic}" for topic, *_ in PUBLISHED),
-                           "--service", "echo_types"))
-        came_in = _events_until(links[1], _carried("in", {f"/{topic}" for topic, *_ in PUBLISHED} | {"/echo_types"}))
+                           "--service", "echo_types", "--action", "/fibonacci"))
+        action = {f"/fibonacci/_action/{part}"
+                  for part in ("send_goal", "cancel_goal", "get_result", "feedback", "status")}
+        came_in = _events_until(links[1], _carried("in", {f"/{topic}" for topic, *_ in PUBLISHED} | {"/echo_types"}
+                                                   | action))
         called = roc("service", "call", "/echo_types", "test_msgs/srv/BasicTypes",
                      "{int32_value: 7, string_value: across}", "--format", "json", env=b)
         assert called.returncode == 0, called.stderr
         response = json.loads(called.stdout.splitlines()[-1])
         assert (response["response"]["int32_value"], response["response"]["string_value"]) == (7, "across")
+        goal = roc("action", "send_goal", "/fibonacci", "test_msgs/action/Fibonacci", "{order: 5}", env=b)
+        assert goal.returncode == 0, goal.stderr
+        assert "sequence:\n- 0\n- 1\n- 1\n- 2\n- 3\n- 5\n" in goal.stdout
+        assert "Goal finished with status: SUCCEEDED" in goal.stdout
         # listeners that start later still: the latched message is kept on both sides
         processes += start_nodes([[_listener("a")]], a) + start_nodes([[_listener("b")]], b)
         direct, bridged = _first_messages(processes[-2]), _first_messages(processes[-1])
@@ -106,8 +115,8 @@ def test_topics_arrive_intact_with_their_names_types_and_qos_and_a_service_answe
         assert "uint64_value=9223372036854775808" in bridged["basic"]
         described = {e["topic"]: (e["type"], e.get("reliability"), e.get("durability"))
                      for e in came_in if e["event"] == "bridging"}
-        assert described == {e["topic"]: (e["type"], e.get("reliability"), e.get("durability"))
-                             for e in out if e["event"] == "bridging"}
+        assert {e["topic"]: described[e["topic"]] for e in out if e["event"] == "bridging"} == {
+            e["topic"]: (e["type"], e.get("reliability"), e.get("durability")) for e in out if e["event"] == "bridging"}
         assert described["/echo_types"] == ("test_msgs/srv/BasicTypes", None, None)
         assert described["/cmd"] == ("geometry_msgs/msg/Twist", "best_effort", "volatile")
         assert described["/latched"] == ("std_msgs/msg/String", "reliable", "transient_local")
@@ -157,7 +166,7 @@ def test_both_ways_without_loops_and_a_late_publisher(tmp_path: Path) -> None:
     (["--zenoh-listen", "nonsense", "/chatter"], "--zenoh-listen nonsense: Endpoints must be of the form "
                                                  "<protocol>/<address>"),
     (["--zenoh-connect", "tcp/127.0.0.1:x", "/chatter"], "--zenoh-connect tcp/127.0.0.1:x: expected tcp/HOST:PORT"),
-    (["--zenoh-connect", "tcp/127.0.0.1:7447"], "nothing to bridge: name topics, --all or --service"),
+    (["--zenoh-connect", "tcp/127.0.0.1:7447"], "nothing to bridge: name topics, --all, --service or --action"),
     (["--zenoh-connect", "tcp/127.0.0.1:7447", "--from-domain", "1", "/chatter"], "--from-domain, --to-domain"),
     (["--zenoh-config", "missing.json5", "--all"], "missing.json5: not a Zenoh configuration: No such file"),
     (["--zenoh-listen", "tcp/127.0.0.1:7447", "--domain", "300", "--all"], "--domain: expected a ROS domain id"),

@@ -190,11 +190,11 @@ def run_zenoh(args: argparse.Namespace) -> int:
 
     from roc.ros.zenoh_link import ZenohLink, zenoh_config
 
-    if args.from_domain is not None or args.to_domain is not None or args.config or args.action:
-        raise UsageError("--from-domain, --to-domain, --config and --action bridge domains; "
-                         "across Zenoh give --domain and topics, --all or --service")
-    if not args.topics and not args.all and not args.service:
-        raise UsageError("nothing to bridge: name topics, --all or --service")
+    if args.from_domain is not None or args.to_domain is not None or args.config:
+        raise UsageError("--from-domain, --to-domain and --config bridge domains; "
+                         "across Zenoh give --domain and topics, --all, --service or --action")
+    if not args.topics and not args.all and not args.service and not args.action:
+        raise UsageError("nothing to bridge: name topics, --all, --service or --action")
     if not args.zenoh_listen and not args.zenoh_connect and args.zenoh_config is None:
         raise UsageError("give --zenoh-listen ENDPOINT or --zenoh-connect ENDPOINT")
     domain = args.domain if args.domain is not None else os.environ.get("ROS_DOMAIN_ID") or 0
@@ -205,7 +205,7 @@ def run_zenoh(args: argparse.Namespace) -> int:
     config = zenoh_config(args.zenoh_listen, args.zenoh_connect, args.zenoh_config)
     exclude = args.exclude or ["^/rosout$", "^/parameter_events$"]
     link = ZenohLink(domain, [_absolute(t) for t in args.topics], args.include, exclude, args.all, config,
-                     [_absolute(s) for s in args.service])
+                     [_absolute(s) for s in args.service], [_absolute(a) for a in args.action])
     try:
         for event in link.run():
             if args.format == "json":

@@ -12,8 +12,8 @@ creates the publisher before the first message, and its subscribers have matched
 transient local topic's last ``depth`` messages stay in a Zenoh publication cache, which a far side
 that joins later queries (a Zenoh advanced subscriber with history), so latched messages reach it too.
 Topics are looked for again every second, so a publisher that appears later is picked up. Services
-named on both sides are offered by the side with the server (roc.ros.zenoh_services), announced the
-same way (``roc/announce/ZID/NAME/-/TYPE``).
+(and actions' services) named on both sides are offered by the side with the server
+(roc.ros.zenoh_services), announced the same way (``roc/announce/ZID/NAME/-/TYPE``).
 
 No loops: the link forwards only topics with a publisher other than a bridge's (so a topic the link
 only republishes goes no further); the link's participant ignores its own endpoints (the Fast DDS
@@ -40,7 +40,7 @@ import zenoh.ext
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from roc.errors import RocError, UsageError
-from roc.ros.bridge import BRIDGE_NODE, RECEIVE_DEPTH, Route, loop_guard, qos_name
+from roc.ros.bridge import BRIDGE_NODE, RECEIVE_DEPTH, Route, action_routes, loop_guard, qos_name
 from roc.ros.dataplane import qos_profile
 from roc.ros.graph import Graph
 from roc.ros.types import message_class
@@ -132,10 +132,14 @@ class _Topic:
 
 class ZenohLink:
     def __init__(self, domain: int, topics: list[str], include: list[str] = (), exclude: list[str] = (),
-                 everything: bool = False, config: zenoh.Config | None = None, services: list[str] = ()) -> None:
+                 everything: bool = False, config: zenoh.Config | None = None, services: list[str] = (),
+                 actions: list[str] = ()) -> None:
         """Carry ``topics`` (and with ``everything`` each topic whose name matches one of ``include``, all
-        when empty, and none of ``exclude``) and ``services`` between ROS domain ``domain`` and the Zenoh
-        peers ``config`` names, both ways (a service is offered by the side with its server)."""
+        when empty, and none of ``exclude``), ``services`` and ``actions`` between ROS domain ``domain`` and
+        the Zenoh peers ``config`` names, both ways (a service or action is offered by the side with its
+        server; an action is its three services and two topics)."""
+        parts = [part for name in actions for part in action_routes(Route(name, domain, domain, kind="action"))]
+        topics = [*topics, *(part.name for part in parts if part.kind == "topic")]
         self.domain = domain
         self.topics = set(topics)
         self.include = [re.compile(pattern) for pattern in include]
@@ -144,7 +148,7 @@ class ZenohLink:
         self.events: queue.SimpleQueue[dict[str, Any]] = queue.SimpleQueue()
         self.outgoing: dict[str, _Topic] = {}
         self.incoming: dict[str, _Topic] = {}
-        self.services = set(services)
+        self.services = {*services, *(part.name for part in parts if part.kind == "service")}
         self.offers: dict[str, ServiceOffer] = {}
         self.proxies: dict[str, ServiceProxy] = {}
         self.errors: deque[str] = deque()
