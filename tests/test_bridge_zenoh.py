@@ -4,6 +4,7 @@ to a Zenoh session (one listens on a free TCP port, the other connects), with re
 from __future__ import annotations
 
 import json
+import shutil
 import socket
 import subprocess
 import time
@@ -160,6 +161,44 @@ def test_both_ways_without_loops_and_a_late_publisher(tmp_path: Path) -> None:
         received = [line for line in process.stdout.read().splitlines() if line.startswith("{")]
         assert len(received) == len(set(received)), "a message arrived twice"
         assert sum(f"frame_id='{other}'" in line for line in received) > 20
+
+
+def _certificates(directory: Path) -> dict[str, Path]:
+    """A certificate authority and a server certificate for localhost it signs (with openssl)."""
+    files = {name: directory / name for name in ("ca.key", "ca.pem", "server.key", "server.csr", "server.pem",
+                                                 "san.cnf")}
+    files["san.cnf"].write_text("subjectAltName=DNS:localhost,IP:127.0.0.1\n")
+    new_key = ["req", "-newkey", "rsa:2048", "-nodes", "-keyout"]
+    for command in ([*new_key, files["ca.key"], "-x509", "-out", files["ca.pem"], "-days", "1", "-subj", "/CN=roc CA"],
+                    [*new_key, files["server.key"], "-out", files["server.csr"], "-subj", "/CN=localhost"],
+                    ["x509", "-req", "-in", files["server.csr"], "-CA", files["ca.pem"], "-CAkey", files["ca.key"],
+                     "-CAcreateserial", "-out", files["server.pem"], "-days", "1", "-extfile", files["san.cnf"]]):
+        subprocess.run(["openssl", *map(str, command)], check=True, capture_output=True)
+    return files
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("openssl") is None, reason="openssl makes the test certificates")
+def test_tls_as_zenoh_configures_it(tmp_path: Path) -> None:
+    a = graph_env(120, tmp_path / "a")
+    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(125)}
+    files = _certificates(tmp_path)
+    listen, connect = tmp_path / "listen.json5", tmp_path / "connect.json5"
+    no_scouting = "scouting: {multicast: {enabled: false}}"
+    listen.write_text(f'{{{no_scouting}, transport: {{link: {{tls: {{listen_private_key: "{files["server.key"]}", '
+                      f'listen_certificate: "{files["server.pem"]}"}}}}}}}}')
+    connect.write_text(f'{{{no_scouting}, transport: {{link: {{tls: {{root_ca_certificate: "{files["ca.pem"]}"}}}}}}}}')
+    endpoint = f"tls/localhost:{_free_port()}"
+    talker = start_nodes([[{"name": "talker", "publishers": [
+        {"topic": "chatter", "type": "std_msgs/msg/String", "values": {"data": "secret"}, "rate_hz": 10}]}]], a)
+    links = []
+    try:
+        links = [_link(a, f"--zenoh-listen {endpoint}", "--zenoh-config", str(listen), "/chatter"),
+                 _link(b, f"--zenoh-connect {endpoint}", "--zenoh-config", str(connect), "/chatter")]
+        _events_until(links[1], _carried("in", {"/chatter"}))
+        assert roc("topic", "echo", "/chatter", "--once", "--no-daemon", env=b).stdout == "data: secret\n---\n"
+    finally:
+        stop_all([*links, *talker])
 
 
 @pytest.mark.parametrize("args, error", [
