@@ -53,6 +53,9 @@ SCAN_SECONDS = 1.0
 SERVER_NODE = "_roc_foxglove"
 SUBPROTOCOLS = ("foxglove.sdk.v1", "foxglove.websocket.v1")  # the SDK's own name first
 SEPARATOR = "=" * 80
+UNKNOWN_CHANNEL = re.compile(r"Unknown channel ID: (\d+)")  # the SDK's status text
+RETRIES, RETRY_SECONDS = 20, 0.05
+CLOSE_SECONDS = 1.0  # the SDK server does not answer a close frame: wait this long, not websockets' 10 s
 
 
 def schema_text(name: str) -> str:
@@ -126,15 +129,16 @@ class _Relay:
 
     async def _start(self, host: str, port: int):
         return await serve(self._relay, host, port, subprotocols=list(SUBPROTOCOLS), compression=None,
-                           max_size=None)
+                           max_size=None, close_timeout=CLOSE_SECONDS)
 
     async def _relay(self, client) -> None:
         peer = ":".join(str(part) for part in client.remote_address[:2])
         self.events.put({"event": "client_connected", "client": peer, "subprotocol": client.subprotocol})
         try:
             async with connect(f"ws://127.0.0.1:{self.upstream}", subprotocols=[SUBPROTOCOLS[0]],
-                               compression=None, max_size=None) as server:
-                pumps = [asyncio.ensure_future(_pump(client, server)), asyncio.ensure_future(_pump(server, client))]
+                               compression=None, max_size=None, close_timeout=CLOSE_SECONDS) as server:
+                session = _Session(client, server)
+                pumps = [asyncio.ensure_future(session.upward()), asyncio.ensure_future(session.downward())]
                 _done, pending = await asyncio.wait(pumps, return_when=asyncio.FIRST_COMPLETED)
                 for pump in pending:
                     pump.cancel()
@@ -155,15 +159,79 @@ class _Relay:
             self._stop_loop()
 
 
-async def _pump(source, target) -> None:
-    """Frames from ``source`` to ``target`` (text stays text, binary binary) until either closes."""
+class _Session:
+    """One client's frames relayed both ways unchanged (text stays text, binary binary), with one repair.
+
+    The SDK sends an ``advertise`` before it records the channel as advertised to that client, so a
+    client that subscribes at once (as the Foxglove app does) may get "Unknown channel ID". Such a
+    subscription, to a channel the relay saw advertised, is sent again a little later instead of
+    passing the error on."""
+
+    def __init__(self, client, server) -> None:
+        self.client, self.server = client, server
+        self.advertised: set[int] = set()
+        self.asked: dict[int, dict] = {}  # channel id -> the client's subscription to it
+        self.retries: dict[int, int] = {}
+
+    async def upward(self) -> None:
+        await self._pump(self.client, self.server, self._from_client)
+
+    async def downward(self) -> None:
+        await self._pump(self.server, self.client, self._from_server)
+
+    @staticmethod
+    async def _pump(source, target, keep) -> None:
+        """Frames from ``source`` to ``target`` (those ``keep`` passes) until either side closes; then
+        ``target`` is closed too."""
+        try:
+            async for frame in source:
+                if keep(_control(frame)):
+                    await target.send(frame)
+        except ConnectionClosed:
+            pass
+        finally:
+            await target.close()
+
+    def _from_client(self, op: dict) -> bool:
+        if op.get("op") == "subscribe":
+            self.asked.update({s.get("channelId"): s for s in op.get("subscriptions", [])})
+        return True
+
+    def _from_server(self, op: dict) -> bool:
+        if op.get("op") == "advertise":
+            self.advertised.update(channel.get("id") for channel in op.get("channels", []))
+        elif op.get("op") == "unadvertise":
+            self.advertised.difference_update(op.get("channelIds", []))
+        elif op.get("op") == "status":
+            return not self._retry(op.get("message", ""))
+        return True
+
+    def _retry(self, message: str) -> bool:
+        found = UNKNOWN_CHANNEL.fullmatch(message)
+        channel = int(found.group(1)) if found else None
+        if channel not in self.advertised or channel not in self.asked or self.retries.get(channel, 0) >= RETRIES:
+            return False
+        self.retries[channel] = self.retries.get(channel, 0) + 1
+        subscribe = json.dumps({"op": "subscribe", "subscriptions": [self.asked[channel]]})
+        asyncio.get_running_loop().call_later(RETRY_SECONDS, asyncio.ensure_future, self._send_up(subscribe))
+        return True
+
+    async def _send_up(self, frame: str) -> None:
+        try:
+            await self.server.send(frame)
+        except ConnectionClosed:
+            pass
+
+
+def _control(frame: str | bytes) -> dict:
+    """A text frame's JSON object (a control message), else {}."""
+    if isinstance(frame, bytes):
+        return {}
     try:
-        async for frame in source:
-            await target.send(frame)
-    except ConnectionClosed:
-        pass
-    finally:
-        await target.close()
+        op = json.loads(frame)
+    except ValueError:
+        return {}
+    return op if isinstance(op, dict) else {}
 
 
 class FoxgloveServer:
@@ -322,10 +390,11 @@ class FoxgloveServer:
                 next_scan = time.monotonic() + SCAN_SECONDS
             if now - last_rates >= period:
                 with self.lock:
-                    active = {name: topic.count for name, topic in self.topics.items() if topic.subscription}
-                yield {"event": "rates", "rates": {name: (count - counts.get(name, 0)) / (now - last_rates)
-                                                   for name, count in active.items()}}
-                counts, last_rates = active, now
+                    now_counts = {name: topic.count for name, topic in self.topics.items()}
+                    active = [name for name, topic in self.topics.items() if topic.subscription]
+                yield {"event": "rates", "rates": {name: (now_counts[name] - counts.get(name, 0)) / (now - last_rates)
+                                                   for name in active}}
+                counts, last_rates = now_counts, now
             try:
                 yield self.events.get(timeout=max(0.01, min(next_scan, last_rates + period) - time.monotonic()))
             except queue.Empty:
