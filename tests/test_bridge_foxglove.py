@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import asyncio
 import json
 import queue
 import signal
@@ -18,7 +19,7 @@ from build_helpers import BIN, stop_process
 from graph_helpers import graph_env, roc, start_nodes, stop_all
 from websockets.sync.client import connect
 
-from roc.ros.foxglove_server import SEPARATOR, schema_text
+from roc.ros.foxglove_server import SEPARATOR, _Session, schema_text
 from roc.ros.interfaces import definition_path
 
 SUBPROTOCOLS = ["foxglove.sdk.v1", "foxglove.websocket.v1"]
@@ -65,6 +66,12 @@ class Bridge:
                 self.events.append(json.loads(self.lines.get(timeout=max(0.1, deadline - time.monotonic()))))
             except queue.Empty:
                 raise AssertionError(f"no such event in {seconds} s; got {self.events}") from None
+
+    def drain(self) -> list[dict]:
+        """Every event so far."""
+        while not self.lines.empty():
+            self.events.append(json.loads(self.lines.get()))
+        return self.events
 
     def stop(self) -> int:
         """Ctrl+C, as a person stops it: the exit code."""
@@ -244,15 +251,20 @@ def test_a_later_topic_is_advertised_and_unadvertised_when_it_goes(bridge: Bridg
 
 
 @pytest.mark.slow
-def test_include_and_exclude_select_the_channels(talker_env) -> None:
+def test_include_and_exclude_select_the_channels_and_ctrl_c_stops_with_a_client(talker_env) -> None:
     env, _talker = talker_env
     served = Bridge(env, "--include", "^/c", "--exclude", "^/cmd$")
     try:
-        served.event(lambda e: e["event"] == "advertised" and e["topic"] == "/chatter")
-        time.sleep(2)  # two more scans
-        assert [e["topic"] for e in served.events if e["event"] == "advertised"] == ["/chatter"]
+        with _client(served.port, "foxglove.websocket.v1") as ws:
+            client = Client(ws)
+            client.subscribe(1, "/chatter")
+            time.sleep(2)  # two more scans
+            assert [e["topic"] for e in served.drain() if e["event"] == "advertised"] == ["/chatter"]
+            assert set(client.channels) == {"/chatter"}
+            assert served.stop() == 130  # Ctrl+C with a client connected and subscribed
+        assert served.process.stderr.read() == "roc: interrupted\n"  # no traceback, no thread left hanging
     finally:
-        assert served.stop() == 130
+        stop_process(served.process)
 
 
 def test_a_port_in_use_is_one_line(tmp_path: Path) -> None:
@@ -274,3 +286,39 @@ def test_a_port_in_use_is_one_line(tmp_path: Path) -> None:
 def test_bad_foxglove_options_are_one_line(tmp_path: Path, args: list[str], error: str) -> None:
     result = roc("bridge", "--foxglove", *args, env=graph_env(140, tmp_path))
     assert result.returncode == 2 and error in result.stderr.splitlines()[0], result.stderr
+
+
+class _Connection:
+    """A stand-in for one side of a relayed WebSocket connection: the frames it brings, those sent to it."""
+
+    def __init__(self, *frames: str) -> None:
+        self.frames, self.sent = list(frames), []
+
+    async def __aiter__(self):
+        for frame in self.frames:
+            yield frame
+
+    async def send(self, frame: str) -> None:
+        self.sent.append(frame)
+
+    async def close(self) -> None:
+        pass
+
+
+def test_the_relay_sends_again_a_subscription_refused_for_a_channel_just_advertised() -> None:
+    subscribe = {"op": "subscribe", "subscriptions": [{"id": 3, "channelId": 5}, {"id": 4, "channelId": 9}]}
+    client = _Connection(json.dumps(subscribe))
+    server = _Connection(json.dumps({"op": "advertise", "channels": [{"id": 5, "topic": "/a"}]}),
+                         json.dumps({"op": "status", "level": 2, "message": "Unknown channel ID: 5"}),
+                         json.dumps({"op": "status", "level": 2, "message": "Unknown channel ID: 9"}))
+
+    async def relay() -> None:
+        session = _Session(client, server)
+        await session.upward()
+        await session.downward()
+        await asyncio.sleep(0.3)
+    asyncio.run(relay())
+    assert [json.loads(frame) for frame in server.sent] == [
+        subscribe, {"op": "subscribe", "subscriptions": [{"id": 3, "channelId": 5}]}]
+    assert [json.loads(frame)["op"] for frame in client.sent] == ["advertise", "status"]  # 9 was never advertised
+    assert "Unknown channel ID: 9" in client.sent[-1]

@@ -55,7 +55,7 @@ SUBPROTOCOLS = ("foxglove.sdk.v1", "foxglove.websocket.v1")  # the SDK's own nam
 SEPARATOR = "=" * 80
 UNKNOWN_CHANNEL = re.compile(r"Unknown channel ID: (\d+)")  # the SDK's status text
 RETRIES, RETRY_SECONDS = 20, 0.05
-CLOSE_SECONDS = 1.0  # the SDK server does not answer a close frame: wait this long, not websockets' 10 s
+CLOSE_SECONDS = 1.0  # a peer that does not answer a close frame is given up on then (websockets waits 10 s)
 
 
 def schema_text(name: str) -> str:
