@@ -102,7 +102,6 @@ class _ClientTopic:
     """A channel a client advertised, and the ROS publisher its messages go to."""
 
     topic: str
-    type: str
     cls: type
     encoding: str
     publisher: Any
@@ -235,6 +234,9 @@ def _control(frame: str | bytes) -> dict:
 
 
 class FoxgloveServer:
+    """The relay on ``host:port``, the SDK server behind it and a hidden node in ``domain`` (default
+    ROS_DOMAIN_ID); ``run`` drives it, ``close`` stops all three."""
+
     def __init__(self, host: str = "127.0.0.1", port: int = 8765, domain: int | None = None,
                  include: list[str] = (), exclude: list[str] = ()) -> None:
         try:
@@ -250,15 +252,18 @@ class FoxgloveServer:
         self.relay = _Relay(host, port, self.events)  # first: a port in use fails before ROS starts
         self.port = self.relay.server.sockets[0].getsockname()[1]
         self.context = foxglove.Context()
+        self.sdk = None
         try:
             self.sdk = foxglove.start_server(name="roc bridge", host="127.0.0.1", port=0, context=self.context,
                                              capabilities=[Capability.ClientPublish], server_listener=_Listener(self),
                                              supported_encodings=["cdr", "json"])
-        except Exception:
+            self.relay.upstream = self.sdk.port
+            self.graph = Graph(SERVER_NODE, domain_id=domain)
+        except BaseException:
             self.relay.close()
+            if self.sdk is not None:
+                self.sdk.stop()
             raise
-        self.relay.upstream = self.sdk.port
-        self.graph = Graph(SERVER_NODE, domain_id=domain)
 
     def close(self) -> None:
         self.relay.close()
@@ -349,8 +354,7 @@ class FoxgloveServer:
             return
         with self.lock:
             publisher = self.graph.node.create_publisher(cls, channel.topic, QoSProfile(depth=10))
-            self.client_topics[(client, channel.id)] = _ClientTopic(channel.topic, channel.schema_name, cls,
-                                                                    channel.encoding, publisher)
+            self.client_topics[(client, channel.id)] = _ClientTopic(channel.topic, cls, channel.encoding, publisher)
         self.events.put({"event": "client_advertised", **base})
 
     def client_unadvertise(self, client: int, channel_id: int) -> None:
