@@ -225,6 +225,13 @@ def test_client_publishing_reaches_a_ros_subscriber(bridge: Bridge, talker_env) 
             {"id": 9, "topic": "/nowhere", "encoding": "json", "schemaName": "no_such_msgs/msg/Thing"}]}))
         refused = bridge.event(lambda e: e["event"] == "client_publish_refused")
         assert refused["topic"] == "/nowhere" and "no_such_msgs" in refused["reason"]
+        client.ws.send(json.dumps({"op": "advertise", "channels": [
+            {"id": 10, "topic": "/from_json", "encoding": "json", "schemaName": "std_msgs/msg/String"}]}))
+        bridge.event(lambda _e: sum(e["event"] == "client_advertised" and e["topic"] == "/from_json"
+                                    for e in bridge.events) == 2)
+        client.send(10, json.dumps({"colour": "red"}).encode())
+        wrong = bridge.event(lambda e: e["event"] == "client_message_refused")
+        assert wrong["topic"] == "/from_json" and "colour" in wrong["reason"], wrong
 
 
 def _twist(x: float):
