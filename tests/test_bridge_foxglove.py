@@ -25,7 +25,9 @@ from roc.ros.interfaces import definition_path
 SUBPROTOCOLS = ["foxglove.sdk.v1", "foxglove.websocket.v1"]
 TALKER = {"name": "talker", "publishers": [
     {"topic": "chatter", "type": "std_msgs/msg/String", "values": {"data": "hi"}, "rate_hz": 20},
-    {"topic": "cmd", "type": "geometry_msgs/msg/Twist", "values": {}, "rate_hz": 20, "reliability": "best_effort"}],
+    {"topic": "cmd", "type": "geometry_msgs/msg/Twist", "values": {}, "rate_hz": 20, "reliability": "best_effort"},
+    {"topic": "latched", "type": "std_msgs/msg/String", "values": {"data": "kept"}, "durability": "transient_local",
+     "depth": 1}],
     "subscribers": [{"topic": "from_json", "type": "std_msgs/msg/String", "print": True},
                     {"topic": "from_cdr", "type": "geometry_msgs/msg/Twist", "print": True}]}
 
@@ -232,6 +234,13 @@ def test_client_publishing_reaches_a_ros_subscriber(bridge: Bridge, talker_env) 
         client.send(10, json.dumps({"colour": "red"}).encode())
         wrong = bridge.event(lambda e: e["event"] == "client_message_refused")
         assert wrong["topic"] == "/from_json" and "colour" in wrong["reason"], wrong
+
+
+@pytest.mark.slow
+def test_every_client_gets_a_transient_local_topics_kept_message(bridge: Bridge) -> None:
+    with _client(bridge.port, "foxglove.sdk.v1") as first, _client(bridge.port, "foxglove.websocket.v1") as second:
+        assert _deserialize(Client(first).subscribe(1, "/latched"), "std_msgs/msg/String").data == "kept"
+        assert _deserialize(Client(second).subscribe(1, "/latched"), "std_msgs/msg/String").data == "kept"
 
 
 def _twist(x: float):

@@ -5,7 +5,9 @@ Every topic of the domain that has a publisher (other than ours), and matches ``
 type's, see ``schema_text``), message encoding ``cdr``. The raw CDR bytes of a ROS message are
 logged as they arrive, never deserialised. Topics are looked for every second: new ones are
 advertised, vanished ones unadvertised. A topic is subscribed in ROS only while a client subscribes
-to its channel (as foxglove_bridge does), with QoS following its publishers. With ``clientPublish``,
+to its channel (as foxglove_bridge does), with QoS following its publishers; a transient-local
+topic is subscribed anew for each client that joins, so that it too gets the kept messages (clients
+already subscribed get them again). With ``clientPublish``,
 a client's channel (encoding ``cdr``, or ``json`` with a ROS message type as ``schemaName``) gets a
 ROS publisher on its topic: CDR is published as it is, JSON sets the message's fields.
 
@@ -36,7 +38,7 @@ from typing import Any
 import foxglove
 from foxglove import Channel, Schema
 from foxglove.websocket import Capability, ServerListener
-from rclpy.qos import QoSProfile
+from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosidl_parser import definition as idl
 from websockets.asyncio.client import connect
 from websockets.asyncio.server import serve
@@ -50,6 +52,7 @@ from roc.ros.messages import fill_message
 from roc.ros.types import message_class, type_name
 
 SCAN_SECONDS = 1.0
+LATCHED = DurabilityPolicy.TRANSIENT_LOCAL
 SERVER_NODE = "_roc_foxglove"
 SUBPROTOCOLS = ("foxglove.sdk.v1", "foxglove.websocket.v1")  # the SDK's own name first
 SEPARATOR = "=" * 80
@@ -315,7 +318,10 @@ class FoxgloveServer:
             if found is None:
                 return
             name, topic = found
+            joins = client not in topic.clients
             topic.clients.add(client)
+            if joins and topic.subscription is not None and topic.subscription.qos_profile.durability == LATCHED:
+                self._unsubscribe_ros(topic)  # a new subscription gets the kept messages for the new client too
             if topic.subscription is None:
                 qos = qos_profile({"profile": "default"}, self.graph.node.get_publishers_info_by_topic(name))
                 log = topic.channel.log
