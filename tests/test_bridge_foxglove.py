@@ -166,7 +166,8 @@ def _text(type_name: str) -> str:
 def test_schema_text_is_the_msg_then_each_nested_type_once_depth_first() -> None:
     section = f"{SEPARATOR}\nMSG: "
     assert schema_text("geometry_msgs/msg/Twist") == "\n".join([
-        _text("geometry_msgs/msg/Twist"), f"{section}geometry_msgs/msg/Vector3", _text("geometry_msgs/msg/Vector3")]) + "\n"
+        _text("geometry_msgs/msg/Twist"), f"{section}geometry_msgs/msg/Vector3",
+        _text("geometry_msgs/msg/Vector3")]) + "\n"
     nested = ["std_msgs/msg/Header", "builtin_interfaces/msg/Time", "geometry_msgs/msg/Pose",
               "geometry_msgs/msg/Point", "geometry_msgs/msg/Quaternion"]
     assert schema_text("geometry_msgs/msg/PoseStamped") == "\n".join(
@@ -183,7 +184,8 @@ def test_a_client_gets_channels_with_ros2msg_schemas_and_cdr_messages(bridge: Br
         info = client.until(lambda: next((op for op in client.ops if op["op"] == "serverInfo"), None))
         assert "clientPublish" in info["capabilities"] and {"cdr", "json"} <= set(info["supportedEncodings"])
         cmd = client.channel("/cmd")
-        assert (cmd["encoding"], cmd["schemaName"], cmd["schemaEncoding"]) == ("cdr", "geometry_msgs/msg/Twist", "ros2msg")
+        assert (cmd["encoding"], cmd["schemaName"], cmd["schemaEncoding"]) == (
+            "cdr", "geometry_msgs/msg/Twist", "ros2msg")
         assert cmd["schema"] == schema_text("geometry_msgs/msg/Twist")
         assert f"{SEPARATOR}\nMSG: geometry_msgs/msg/Vector3\n" in cmd["schema"]
         assert client.channel("/chatter")["schemaName"] == "std_msgs/msg/String"
@@ -222,7 +224,8 @@ def test_client_publishing_reaches_a_ros_subscriber(bridge: Bridge, talker_env) 
             except queue.Empty:
                 pass
         assert received == wanted
-        assert bridge.event(lambda e: e["event"] == "client_advertised" and e["topic"] == "/from_cdr")["encoding"] == "cdr"
+        cdr = bridge.event(lambda e: e["event"] == "client_advertised" and e["topic"] == "/from_cdr")
+        assert cdr["encoding"] == "cdr"
         client.ws.send(json.dumps({"op": "advertise", "channels": [
             {"id": 9, "topic": "/nowhere", "encoding": "json", "schemaName": "no_such_msgs/msg/Thing"}]}))
         refused = bridge.event(lambda e: e["event"] == "client_publish_refused")
