@@ -9,6 +9,7 @@ from typing import Any
 
 import yaml
 
+from roc.commands import bridge_foxglove
 from roc.errors import UsageError
 from roc.fsutil import read_yaml
 from roc.render import json_line, print_text, table_lines
@@ -38,6 +39,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --all: never topics matching one of these (default: /rosout, /parameter_events)")
     parser.add_argument("--format", choices=("text", "json"), default="text",
                         help="json: one status object per line")
+    # -- to the browser: --foxglove and its options (roc/commands/bridge_foxglove.py) --
+    bridge_foxglove.add_arguments(parser)
 
 
 def _domain(value: Any, where: str) -> int:
@@ -151,6 +154,8 @@ def _text(event: dict[str, Any]) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.foxglove:  # to the browser: roc/commands/bridge_foxglove.py
+        return bridge_foxglove.run(args)
     from roc.ros.bridge import DomainBridge
 
     routes = _routes(args)
