@@ -9,6 +9,7 @@ from typing import Any
 
 import yaml
 
+from roc.commands import bridge_foxglove, bridge_zenoh
 from roc.errors import UsageError
 from roc.fsutil import read_yaml
 from roc.render import json_line, print_text, table_lines
@@ -38,7 +39,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --all: never topics matching one of these (default: /rosout, /parameter_events)")
     parser.add_argument("--format", choices=("text", "json"), default="text",
                         help="json: one status object per line")
-    add_zenoh_arguments(parser)
+    # -- to the browser: --foxglove and its options (roc/commands/bridge_foxglove.py) --
+    bridge_foxglove.add_arguments(parser)
+    # -- across networks on Zenoh: --zenoh-listen/--zenoh-connect (roc/commands/bridge_zenoh.py) --
+    bridge_zenoh.add_arguments(parser)
 
 
 def _domain(value: Any, where: str) -> int:
@@ -152,8 +156,10 @@ def _text(event: dict[str, Any]) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.zenoh_listen or args.zenoh_connect or args.zenoh_config:
-        return run_zenoh(args)
+    if args.foxglove:  # to the browser: roc/commands/bridge_foxglove.py
+        return bridge_foxglove.run(args)
+    if args.zenoh_listen or args.zenoh_connect or args.zenoh_config:  # roc/commands/bridge_zenoh.py
+        return bridge_zenoh.run(args)
     from roc.ros.bridge import DomainBridge
 
     routes = _routes(args)
@@ -167,61 +173,4 @@ def run(args: argparse.Namespace) -> int:
                 print_text(_text(event))
     finally:
         bridge.close()
-    return 0
-
-
-# ---- across networks on Zenoh (roc.ros.zenoh_link) -------------------------------------------------
-
-def add_zenoh_arguments(parser: argparse.ArgumentParser) -> None:
-    group = parser.add_argument_group("across networks on Zenoh (run one roc bridge on each side)")
-    group.add_argument("--zenoh-listen", action="append", default=[], metavar="ENDPOINT",
-                       help="accept Zenoh peers on this endpoint, e.g. tcp/0.0.0.0:7447")
-    group.add_argument("--zenoh-connect", action="append", default=[], metavar="ENDPOINT",
-                       help="connect to a Zenoh peer, e.g. tcp/robot.local:7447 (retried until it answers)")
-    group.add_argument("--zenoh-config", type=Path, metavar="FILE",
-                       help="a Zenoh JSON5 configuration (e.g. for TLS); the endpoints given are added to it")
-    group.add_argument("--domain", type=int, metavar="ID",
-                       help="the local ROS domain to carry topics from and to (default: ROS_DOMAIN_ID, else 0)")
-
-
-def run_zenoh(args: argparse.Namespace) -> int:
-    """Carry the selected topics between the local domain and the Zenoh peers, both ways, until Ctrl+C."""
-    import os
-
-    from roc.ros.zenoh_link import ZenohLink, zenoh_config
-
-    if args.from_domain is not None or args.to_domain is not None or args.config:
-        raise UsageError("--from-domain, --to-domain and --config bridge domains; "
-                         "across Zenoh give --domain and topics, --all, --service or --action")
-    if not args.topics and not args.all and not args.service and not args.action:
-        raise UsageError("nothing to bridge: name topics, --all, --service or --action")
-    if not args.zenoh_listen and not args.zenoh_connect and args.zenoh_config is None:
-        raise UsageError("give --zenoh-listen ENDPOINT or --zenoh-connect ENDPOINT")
-    domain = args.domain if args.domain is not None else os.environ.get("ROS_DOMAIN_ID") or 0
-    try:
-        domain = _domain(int(domain), "--domain")
-    except ValueError:
-        raise UsageError(f"ROS_DOMAIN_ID: expected a ROS domain id (0 to 232), got {domain!r}") from None
-    config = zenoh_config(args.zenoh_listen, args.zenoh_connect, args.zenoh_config)
-    exclude = args.exclude or ["^/rosout$", "^/parameter_events$"]
-    link = ZenohLink(domain, [_absolute(t) for t in args.topics], args.include, exclude, args.all, config,
-                     [_absolute(s) for s in args.service], [_absolute(a) for a in args.action])
-    try:
-        for event in link.run():
-            if args.format == "json":
-                print_text(json_line(event))
-            elif event["event"] == "bridging":
-                way = (f"domain {event['domain']} -> zenoh" if event["direction"] == "out"
-                       else f"zenoh -> domain {event['domain']}")
-                qos = f" ({event['reliability']}, {event['durability']})" if event["kind"] == "topic" else ""
-                kind = "" if event["kind"] == "topic" else "service "
-                print_text(f"bridging {kind}{event['topic']} [{event['type']}] {way}{qos}\n")
-            elif event["event"] == "session":
-                print_text(f"zenoh session {event['zid']} on domain {event['domain']}\n")
-            elif event["event"] == "peer":
-                print_text(f"zenoh peer {event['zid']} {'connected' if event['connected'] else 'gone'}\n")
-            elif event["event"] != "rates" or event["rates"]:
-                print_text(_text(event))
-    finally:
-        link.close()
     return 0
