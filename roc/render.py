@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import json
 import sys
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from functools import lru_cache
 from typing import Any, TextIO
 
@@ -22,6 +22,12 @@ def print_text(text: str, stream: TextIO | None = None) -> None:
     out = stream or sys.stdout
     out.write(text)
     out.flush()
+
+
+def print_events(events: Iterable[dict[str, Any]], fmt: str, text: Callable[[dict[str, Any]], str]) -> None:
+    """Status events as they come (``roc bridge``): JSON lines, or each event's ``text`` (may be empty)."""
+    for event in events:
+        print_text(json_line(event) if fmt == "json" else text(event))
 
 
 def print_json(data: Any, stream: TextIO | None = None) -> None:

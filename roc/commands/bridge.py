@@ -12,7 +12,7 @@ import yaml
 from roc.commands import bridge_foxglove, bridge_zenoh
 from roc.errors import UsageError
 from roc.fsutil import read_yaml
-from roc.render import json_line, print_text, table_lines
+from roc.render import print_events, table_lines
 
 QOS_KEYS = {"reliability", "durability", "history", "depth", "deadline", "lifespan", "liveliness",
             "liveliness_lease_duration"}
@@ -100,12 +100,12 @@ def routes_from_config(path: Path) -> list:
             raise UsageError(f"{where}: expected a mapping such as {{type: pkg/msg/Type}}")
         unknown = set(spec) - ENTRY_KEYS
         if unknown:
-            raise UsageError(f"{where}: unknown key '{sorted(unknown)[0]}' (known: {', '.join(sorted(ENTRY_KEYS))})")
+            raise UsageError(f"{where}: unknown key '{min(unknown)}' (known: {', '.join(sorted(ENTRY_KEYS))})")
         qos = spec.get("qos") or {}
         if not isinstance(qos, dict) or set(qos) - QOS_KEYS:
             raise UsageError(f"{where}: qos: use {', '.join(sorted(QOS_KEYS))}")
         if set(qos) - SUPPORTED_QOS and any(qos[key] != "auto" for key in set(qos) - SUPPORTED_QOS):
-            raise UsageError(f"{where}: qos: {sorted(set(qos) - SUPPORTED_QOS)[0]}: only 'auto' is supported; "
+            raise UsageError(f"{where}: qos: {min(set(qos) - SUPPORTED_QOS)}: only 'auto' is supported; "
                              f"roc sets {', '.join(sorted(SUPPORTED_QOS))}")
         domains = [_domain(spec.get(key, settings.get(key, 0)), f"{where}: {key}") for key in ("from_domain", "to_domain")]
         remap = spec.get("remap")
@@ -152,7 +152,9 @@ def _text(event: dict[str, Any]) -> str:
                 f"{event['to_domain']}{renamed}{qos}\n")
     if event["event"] == "error":
         return f"error: {event['message']}\n"
-    return "\n".join(table_lines([[name, f"{rate:.1f} {'calls' if name.startswith('service ') else 'msg'}/s"] for name, rate in event["rates"].items()])) + "\n"
+    rows = [[name, f"{rate:.1f} {'calls' if name.startswith('service ') else 'msg'}/s"]
+            for name, rate in event["rates"].items()]
+    return "\n".join(table_lines(rows)) + "\n" if rows else ""
 
 
 def run(args: argparse.Namespace) -> int:
@@ -166,11 +168,7 @@ def run(args: argparse.Namespace) -> int:
     exclude = args.exclude or ["^/rosout$", "^/parameter_events$"]
     bridge = DomainBridge(routes, args.include, exclude, (args.from_domain, args.to_domain) if args.all else None)
     try:
-        for event in bridge.run():
-            if args.format == "json":
-                print_text(json_line(event))
-            elif event["event"] != "rates" or event["rates"]:
-                print_text(_text(event))
+        print_events(bridge.run(), args.format, _text)
     finally:
         bridge.close()
     return 0

@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 
 from roc.errors import UsageError
-from roc.render import json_line, print_text, table_lines
+from roc.render import print_events, table_lines
 
 # The domain bridge's options that mean nothing to --foxglove (which serves every topic of one domain).
 DOMAIN_BRIDGE_OPTIONS = ("topics", "from_domain", "to_domain", "service", "action", "bidirectional", "config",
@@ -67,8 +67,7 @@ def run(args: argparse.Namespace) -> int:
 
     server = FoxgloveServer(args.host, args.port, args.domain, args.include, args.exclude)
     try:
-        for event in server.run():
-            print_text(json_line(event) if args.format == "json" else _text(event))
+        print_events(server.run(), args.format, _text)
     finally:
         server.close()
     return 0

@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from roc.errors import UsageError
-from roc.render import json_line, print_text
+from roc.render import print_events
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -38,7 +38,7 @@ def _text(event: dict[str, Any]) -> str:
         return f"zenoh session {event['zid']} on domain {event['domain']}\n"
     if event["event"] == "peer":
         return f"zenoh peer {event['zid']} {'connected' if event['connected'] else 'gone'}\n"
-    return domain_bridge_text(event) if event["event"] != "rates" or event["rates"] else ""
+    return domain_bridge_text(event)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -61,8 +61,7 @@ def run(args: argparse.Namespace) -> int:
     link = ZenohLink(domain, [_absolute(t) for t in args.topics], args.include, exclude, args.all, config,
                      [_absolute(s) for s in args.service], [_absolute(a) for a in args.action])
     try:
-        for event in link.run():
-            print_text(json_line(event) if args.format == "json" else _text(event))
+        print_events(link.run(), args.format, _text)
     finally:
         link.close()
     return 0

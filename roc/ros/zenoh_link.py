@@ -40,7 +40,14 @@ import zenoh.ext
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from roc.errors import RocError, UsageError
-from roc.ros.bridge import BRIDGE_NODE, RECEIVE_DEPTH, Route, action_routes, loop_guard, qos_name
+from roc.ros.bridge import (
+    BRIDGE_NODE,
+    RECEIVE_DEPTH,
+    Route,
+    action_routes,
+    loop_guard,
+    qos_name,
+)
 from roc.ros.dataplane import qos_profile
 from roc.ros.graph import Graph
 from roc.ros.types import message_class

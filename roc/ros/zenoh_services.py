@@ -3,29 +3,24 @@ queryable on ``roc/service/NAME``; the far side serves the same name and type in
 sends each request (serialised CDR) as a Zenoh query, answering with the reply.
 
 rclpy sends a response when the service callback returns, so the far side's callback waits for the
-query's reply: its server has a node of its own, spun by a multi-threaded executor, as the domain
-bridge's ServiceLink, so a slow call holds one worker thread rather than the link's topics. The
+query's reply: it is a ForwardingServer, as the domain bridge's ServiceLink. The
 offering side answers each query in a worker thread, which waits for the local server.
 """
 
 from __future__ import annotations
 
-import threading
 from collections import deque
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import zenoh
-from rclpy.callback_groups import ReentrantCallbackGroup
-from rclpy.executors import MultiThreadedExecutor
-from rclpy.node import Node
 from rclpy.serialization import deserialize_message, serialize_message
 
+from roc.ros.bridge_services import WORKER_THREADS, ForwardingServer, call
 from roc.ros.graph import Graph
 from roc.ros.types import service_class
 
 SERVICE_PREFIX = "roc/service"
-WORKER_THREADS = 8
 CALL_SECONDS = 30.0  # a call's longest wait for the far server's response
 
 
@@ -42,54 +37,33 @@ class ServiceOffer:
             f"{SERVICE_PREFIX}{name}", lambda query: self._workers.submit(self._answer, query), complete=True)
 
     def _answer(self, query: zenoh.Query) -> None:
-        request = deserialize_message(query.payload.to_bytes(), self._cls.Request)
-        done = threading.Event()
-        future = self._client.call_async(request)
-        future.add_done_callback(lambda _future: done.set())
-        if not done.wait(CALL_SECONDS):
+        response = call(self._client, deserialize_message(query.payload.to_bytes(), self._cls.Request), CALL_SECONDS)
+        if response is None:
             self.errors.append(f"{self.name}: the server did not answer within {CALL_SECONDS:g} s")
             query.reply_err(b"no response")
             return
         self.count += 1
-        query.reply(f"{SERVICE_PREFIX}{self.name}", serialize_message(future.result()))
+        query.reply(f"{SERVICE_PREFIX}{self.name}", serialize_message(response))
 
     def close(self) -> None:
         self._queryable.undeclare()
         self._workers.shutdown(wait=False, cancel_futures=True)
 
 
-class ServiceProxy:
+class ServiceProxy(ForwardingServer):
     """A far side's service served in the local domain, each call a Zenoh query."""
 
     def __init__(self, session: zenoh.Session, graph: Graph, name: str, type_name: str, node_name: str,
                  errors: deque[str]) -> None:
-        self.name, self.count, self.errors = name, 0, errors
         self._session = session
-        self._cls = service_class(type_name)
-        self._node = Node(node_name, context=graph.context, start_parameter_services=False, enable_rosout=False)
-        self._node.create_service(self._cls, name, self._serve, callback_group=ReentrantCallbackGroup())
-        self._executor = MultiThreadedExecutor(num_threads=WORKER_THREADS, context=graph.context)
-        self._executor.add_node(self._node)
-        self._spinner = threading.Thread(target=self._spin, daemon=True)
-        self._spinner.start()
+        super().__init__(graph, name, type_name, node_name, errors)
 
-    def _spin(self) -> None:
-        try:
-            self._executor.spin()
-        except Exception:  # noqa: BLE001 - the context was shut down under it
-            pass
-
-    def _serve(self, request: Any, response: Any) -> Any:
-        """The far server's response; ``response`` (empty) when none came, with an error for ``errors``."""
+    def forward(self, request: Any) -> Any | None:
+        """The far server's response; None when none came."""
         replies = self._session.get(f"{SERVICE_PREFIX}{self.name}", payload=serialize_message(request),
                                     timeout=CALL_SECONDS)
         for reply in replies:
             if reply.ok is not None:
-                self.count += 1
-                return deserialize_message(reply.ok.payload.to_bytes(), self._cls.Response)
+                return deserialize_message(reply.ok.payload.to_bytes(), self.service_type.Response)
         self.errors.append(f"{self.name}: the far side's server did not answer; the caller got an empty response")
-        return response
-
-    def close(self) -> None:
-        self._executor.shutdown(timeout_sec=1)
-        self._node.destroy_node()
+        return None
