@@ -4,12 +4,11 @@
 ``--seconds``, a minimal rclpy subscriber (bench/counting_subscriber.py, on the C++ EventsExecutor)
 in domain 95 itself (the direct subscription) and one in domain 96 behind ``roc bridge --from-domain 95 --to-domain 96``, all
 at once. Prints messages received and lost by each, and the latency at the median and the 99th
-percentile, direct and bridged, and what the bridge adds.
+percentile, direct and bridged, and what the bridge adds. Then the same through the Zenoh link: two
+``roc bridge`` processes joined by Zenoh on localhost TCP (``--zenoh-listen`` in domain 95,
+``--zenoh-connect`` in domain 96).
 
-    python bench/bridge_bench.py [--rates 1000 5000] [--seconds 5] [--zenoh]
-
-``--zenoh``: through two ``roc bridge`` processes joined by Zenoh on localhost TCP instead (one with
-``--zenoh-listen`` in domain 95, one with ``--zenoh-connect`` in domain 96).
+    python bench/bridge_bench.py [--rates 1000 5000] [--seconds 5] [--links domain zenoh]
 
 Localhost discovery. Target (issue 15): no loss at 1 kHz, under 1 % at 5 kHz, added median latency
 under 1 ms. Every process shares the machine's cores (2 here), the publisher's and subscribers' too.
@@ -85,33 +84,36 @@ def rate_run(rate: float, seconds: float, work: Path, zenoh: bool = False) -> di
     return {name: _result(outputs[name]) for name in ("publisher", "direct", "bridged")}
 
 
+LINKS = {"domain": "roc bridge (domain to domain)", "zenoh": "Zenoh (two roc bridge processes)"}
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rates", type=float, nargs="+", default=[1000, 5000])
     parser.add_argument("--seconds", type=float, default=5.0)
-    parser.add_argument("--zenoh", action="store_true", help="through two roc bridges joined by Zenoh")
+    parser.add_argument("--links", nargs="+", choices=sorted(LINKS), default=list(LINKS))
     args = parser.parse_args()
     work = Path(tempfile.mkdtemp(prefix="roc-bridge-bench-"))
-    print(f"through {'Zenoh (two roc bridge processes)' if args.zenoh else 'roc bridge (domain to domain)'}; "
-          f"load average before: {os.getloadavg()[0]:.2f}")
-    print(f"{'rate':>6} {'sent':>7} | {'direct':>7} {'lost':>6} {'med ms':>7} {'p99 ms':>7} | "
+    print(f"load average before: {os.getloadavg()[0]:.2f}")
+    print(f"{'link':>6} {'rate':>6} {'sent':>7} | {'direct':>7} {'lost':>6} {'med ms':>7} {'p99 ms':>7} | "
           f"{'bridged':>7} {'lost':>6} {'med ms':>7} {'p99 ms':>7} | {'added med':>9} {'added p99':>9}")
     verdicts = []
-    for rate in args.rates:
-        result = rate_run(rate, args.seconds, work, args.zenoh)
-        sent = result["publisher"].get("count", 0)
-        direct, bridged = result["direct"], result["bridged"]
-        loss = (sent - bridged["count"]) / sent if sent else 1.0
-        added = (bridged.get("median_ms", float("nan")) - direct.get("median_ms", float("nan")),
-                 bridged.get("p99_ms", float("nan")) - direct.get("p99_ms", float("nan")))
-        print(f"{rate:>6.0f} {sent:>7} | {direct['count']:>7} {sent - direct['count']:>6} "
-              f"{direct.get('median_ms', float('nan')):>7.2f} {direct.get('p99_ms', float('nan')):>7.2f} | "
-              f"{bridged['count']:>7} {sent - bridged['count']:>6} {bridged.get('median_ms', float('nan')):>7.2f} "
-              f"{bridged.get('p99_ms', float('nan')):>7.2f} | {added[0]:>9.2f} {added[1]:>9.2f}")
-        allowed = 0.0 if rate <= 1000 else 0.01
-        verdicts.append(f"{rate:.0f} Hz: loss {loss:.2%} (target {'none' if not allowed else 'under 1%'}), "
-                        f"added median {added[0]:.2f} ms (target under 1 ms): "
-                        f"{'met' if loss <= allowed and added[0] < 1.0 else 'NOT met'}")
+    for link in args.links:
+        for rate in args.rates:
+            result = rate_run(rate, args.seconds, work, link == "zenoh")
+            sent = result["publisher"].get("count", 0)
+            direct, bridged = result["direct"], result["bridged"]
+            loss = (sent - bridged["count"]) / sent if sent else 1.0
+            added = (bridged.get("median_ms", float("nan")) - direct.get("median_ms", float("nan")),
+                     bridged.get("p99_ms", float("nan")) - direct.get("p99_ms", float("nan")))
+            print(f"{link:>6} {rate:>6.0f} {sent:>7} | {direct['count']:>7} {sent - direct['count']:>6} "
+                  f"{direct.get('median_ms', float('nan')):>7.2f} {direct.get('p99_ms', float('nan')):>7.2f} | "
+                  f"{bridged['count']:>7} {sent - bridged['count']:>6} {bridged.get('median_ms', float('nan')):>7.2f} "
+                  f"{bridged.get('p99_ms', float('nan')):>7.2f} | {added[0]:>9.2f} {added[1]:>9.2f}")
+            allowed = 0.0 if rate <= 1000 else 0.01
+            verdicts.append(f"{LINKS[link]}, {rate:.0f} Hz: loss {loss:.2%} (target {'none' if not allowed else 'under 1%'}), "
+                            f"added median {added[0]:.2f} ms (target under 1 ms): "
+                            f"{'met' if loss <= allowed and added[0] < 1.0 else 'NOT met'}")
     print(f"load average after: {os.getloadavg()[0]:.2f}")
     print("\n".join(verdicts))
     return 0
