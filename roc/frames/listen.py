@@ -19,8 +19,8 @@ def require_tf2_msgs() -> None:
         message_class(TF_TYPE)
     except UnknownTypeError:
         raise UsageError("tf2_msgs is not installed (the ROS 2 wheels from PyPI lack it): source a ROS "
-                         "install that has it, or build the tf2_msgs package of roc's "
-                         "workspaces/fixtures/tf with 'roc work build' and source its install/setup.bash") from None
+                         "install that has it, or build roc's example workspace (workspaces/example, which has a "
+                         "tf2_msgs package) with 'roc work build' and source its install/setup.bash") from None
 
 
 class Listener:
