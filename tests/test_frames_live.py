@@ -42,11 +42,15 @@ def sourced(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def tree(sourced):
-    process = subprocess.Popen([sys.executable, str(TF_NODE), "publish"], env=sourced, stdout=subprocess.PIPE,
-                               stderr=subprocess.DEVNULL, text=True)
-    assert process.stdout.readline().strip() == "ready"
-    yield sourced
-    stop_process(process)
+    """Two tf publisher nodes: /tf_publish (map->odom->base_link->laser), /tf_camera (camera->lens on /tf)."""
+    processes = [subprocess.Popen([sys.executable, str(TF_NODE), mode], env=sourced, stdout=subprocess.PIPE,
+                                  stderr=subprocess.DEVNULL, text=True) for mode in ("publish", "camera")]
+    try:
+        assert [process.stdout.readline().strip() for process in processes] == ["ready", "ready"]
+        yield sourced
+    finally:
+        for process in processes:
+            stop_process(process)
 
 
 def frame(*args: str, env: dict[str, str]) -> subprocess.CompletedProcess:
@@ -80,8 +84,12 @@ def test_list_and_tree(tree, tmp_path: Path) -> None:
     assert sorted(rows) == ["base_link", "camera", "laser", "lens", "map", "odom"]
     assert (rows["odom"]["parent"], rows["odom"]["static"]) == ("map", True)
     assert rows["base_link"]["static"] is False and rows["base_link"]["rate"] == pytest.approx(20, rel=0.15)
-    assert rows["base_link"]["publishers"] == ["/tf_publish"] and rows["map"]["parent"] is None
+    assert rows["map"]["parent"] is None and rows["map"]["publishers"] == []
+    # each frame names the node that sent it, although both nodes publish /tf
+    assert {frame: row["publishers"] for frame, row in rows.items() if row["parent"]} == {
+        "odom": ["/tf_publish"], "base_link": ["/tf_publish"], "laser": ["/tf_publish"], "lens": ["/tf_camera"]}
     text = frame("tree", "--duration", "1", env=tree).stdout.splitlines()
+    assert text[1].endswith(", /tf_camera]") and text[3] == "└── odom [static, /tf_publish]"
     assert [line.split(" [")[0] for line in text] == ["camera", "└── lens", "map", "└── odom", "    └── base_link",
                                                       "        └── laser"]
     dot = tmp_path / "tf.dot"
@@ -94,6 +102,18 @@ def test_list_and_tree(tree, tmp_path: Path) -> None:
     drawn = frame("tree", "--duration", "1", "--output", str(svg), env=tree)
     assert drawn.returncode == 0, drawn.stderr
     assert "<svg" in svg.read_text() and ">base_link</text>" in svg.read_text()
+
+
+def test_monitor_gives_rate_delay_and_node_per_frame(tree) -> None:
+    result = frame("monitor", "--duration", "2.5", "--format", "json", env=tree)
+    assert result.returncode == 0, result.stderr
+    last = {}
+    for line in result.stdout.splitlines():
+        row = json.loads(line)
+        last[row["frame"]] = row
+    assert sorted(last) == ["base_link", "lens"]  # dynamic frames only
+    assert (last["base_link"]["publishers"], last["lens"]["publishers"]) == (["/tf_publish"], ["/tf_camera"])
+    assert last["lens"]["rate"] == pytest.approx(10, rel=0.25) and 0 <= last["base_link"]["delay_average"] < 1
 
 
 def test_pub_reaches_a_real_subscriber_and_ctrl_c_stops_it(sourced) -> None:
