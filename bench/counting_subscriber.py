@@ -1,14 +1,23 @@
 #!/usr/bin/env python3
-"""The minimal rclpy subscriber of dataplane_bench.py: counts std_msgs/String messages on TOPIC
-(reliable, depth 1000) until SIGINT, then prints the count as JSON."""
+"""The minimal rclpy subscriber of dataplane_bench.py and bridge_bench.py: counts std_msgs/String
+messages on TOPIC (reliable, depth 1000) until SIGINT, then prints the count as JSON. ``latency``:
+also each message's age on arrival (its data is its publication time, paced_publisher.py ``stamped``),
+as the median and 99th percentile in milliseconds. ``events``: spin with rclpy's C++ EventsExecutor
+(a far cheaper receiver, so that it does not limit what it measures).
+
+    python bench/counting_subscriber.py TOPIC [latency] [events]
+"""
 
 from __future__ import annotations
 
 import json
 import signal
+import statistics
 import sys
+import time
 
 import rclpy
+import rclpy.executors
 from rclpy.qos import QoSProfile
 from std_msgs.msg import String
 
@@ -16,14 +25,30 @@ from std_msgs.msg import String
 def main() -> None:
     rclpy.init(signal_handler_options=rclpy.signals.SignalHandlerOptions.NO)
     node = rclpy.create_node("counting_subscriber")
-    count = [0]
-    node.create_subscription(String, sys.argv[1], lambda _m: count.__setitem__(0, count[0] + 1), QoSProfile(depth=1000))
+    count, ages = [0], []
+    timed = "latency" in sys.argv[2:]
+
+    def received(message: String) -> None:
+        count[0] += 1
+        if timed:
+            ages.append((time.time_ns() - int(message.data)) / 1e6)
+    node.create_subscription(String, sys.argv[1], received, QoSProfile(depth=1000))
     stop = []
     signal.signal(signal.SIGINT, lambda *_: stop.append(True))
+    if "events" in sys.argv[2:]:
+        from rclpy.experimental import EventsExecutor
+
+        executor = EventsExecutor()
+    else:
+        executor = rclpy.executors.SingleThreadedExecutor()
+    executor.add_node(node)
     print("ready", flush=True)
     while not stop:
-        rclpy.spin_once(node, timeout_sec=0.1)
-    print(json.dumps({"count": count[0]}), flush=True)
+        executor.spin_once(timeout_sec=0.1)
+    result = {"count": count[0]}
+    if len(ages) >= 2:
+        result.update(median_ms=statistics.median(ages), p99_ms=statistics.quantiles(ages, n=100)[98])
+    print(json.dumps(result), flush=True)
 
 
 if __name__ == "__main__":

@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
-"""A paced publisher for dataplane_bench.py: std_msgs/String on TOPIC at RATE Hz for SECONDS seconds,
-after WAIT seconds (for the consumers to subscribe). Prints the count and the true rate as JSON.
+"""A paced publisher for dataplane_bench.py and bridge_bench.py: std_msgs/String on TOPIC at RATE Hz
+for SECONDS seconds, after WAIT seconds (for the consumers to subscribe). Prints the count and the
+true rate as JSON. ``stamped``: each message's data is its publication time (``time.time_ns()``), for
+latency (counting_subscriber.py ``latency``).
 
-    python bench/paced_publisher.py TOPIC RATE SECONDS WAIT
+    python bench/paced_publisher.py TOPIC RATE SECONDS WAIT [stamped]
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from std_msgs.msg import String
 
 def main() -> None:
     topic, rate, seconds, wait = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
+    stamped = sys.argv[5:] == ["stamped"]
     rclpy.init()
     node = rclpy.create_node("paced_publisher")
     publisher = node.create_publisher(String, topic, QoSProfile(depth=1000))
@@ -29,6 +32,8 @@ def main() -> None:
         due = start + count * period
         if now < due:  # sleep, not spin: the consumers share the machine's cores
             time.sleep(due - now)
+        if stamped:
+            message.data = str(time.time_ns())
         publisher.publish(message)
         count += 1
     elapsed = time.perf_counter() - start

@@ -43,15 +43,16 @@ def file_sha256(path: Path) -> str:
     return digest.hexdigest()
 
 
-def read_yaml(path: Path):
-    """A YAML file's document; a one-line UsageError naming the file (and line) when it cannot be read
-    or parsed."""
+def read_yaml(path: Path, nodes: bool = False):
+    """A YAML file's document (``nodes``: its node tree, which keeps a mapping's repeated keys); a
+    one-line UsageError naming the file (and line) when it cannot be read or parsed."""
     import yaml
 
     from roc.errors import UsageError
 
     try:
-        return yaml.safe_load(path.read_text())
+        text = path.read_text()
+        return yaml.compose(text, Loader=yaml.SafeLoader) if nodes else yaml.safe_load(text)
     except OSError as error:
         raise UsageError(f"{path}: cannot read it ({error.strerror})") from None
     except yaml.YAMLError as error:

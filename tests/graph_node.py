@@ -3,7 +3,7 @@
     python graph_node.py '{"name": "talker", "namespace": "/", "publishers": [{"topic": "chatter",
         "type": "std_msgs/msg/String", "reliability": "best_effort", "durability": "volatile",
         "depth": 10, "deadline_ms": 0, "values": {"data": "hi"}, "rate_hz": 10}], "subscribers": [{..., "print": true}], "services": [{"name": "reset",
-        "type": "std_srvs/srv/Trigger"}], "actions": [{"name": "fibonacci"}], "parameters": {"max_speed": 1.5}}'
+        "type": "std_srvs/srv/Trigger", "echo": false}], "actions": [{"name": "fibonacci"}], "parameters": {"max_speed": 1.5}}'
 
 Several nodes in one process: pass a JSON list. Prints "ready" once everything is created, then
 spins until killed.
@@ -61,7 +61,7 @@ def make_node(spec: dict) -> Node:
                 print(json.dumps({"topic": topic, "message": repr(msg)}), flush=True)
         node.create_subscription(load(sub["type"]), sub["topic"], received, qos(sub))
     for srv in spec.get("services", []):
-        node.create_service(load(srv["type"]), srv["name"], lambda _req, resp: resp)
+        node.create_service(load(srv["type"]), srv["name"], echo if srv.get("echo") else lambda _req, resp: resp)
     for client in spec.get("clients", []):
         node.create_client(load(client["type"]), client["name"])
     for action in spec.get("actions", []):
@@ -72,6 +72,14 @@ def make_node(spec: dict) -> Node:
                                         callback_group=ReentrantCallbackGroup(),
                                         cancel_callback=lambda _goal: CancelResponse.ACCEPT)
     return node
+
+
+def echo(request, response):
+    """A service whose response repeats the request's fields of the same name (test_msgs/srv/BasicTypes)."""
+    for name in response.get_fields_and_field_types():
+        if hasattr(request, name):
+            setattr(response, name, getattr(request, name))
+    return response
 
 
 def fibonacci(step_seconds: float):

@@ -128,12 +128,15 @@ def test_all_picks_up_a_late_publisher_and_a_config_remaps(domains, tmp_path: Pa
 
 
 @pytest.mark.parametrize("args, config, error", [
-    (["/chatter"], None, "give --from-domain and --to-domain with topics or --all"),
+    (["/chatter"], None, "give --from-domain and --to-domain with topics, --service, --action or --all"),
     (["--from-domain", "3", "--to-domain", "3", "/chatter"], None, "/chatter: bridging domain 3 into itself would loop"),
-    ([], "topics:\n  chatter:\n    type: std_msgs/msg/String\n    reversed: true\n",
-     "topics: chatter: 'reversed' and 'bidirectional' are not supported yet"),
-    ([], "topics:\n  chatter:\n    colour: red\n", "topics: chatter: unknown key 'colour'"),
+    ([], "mode: compress\ntopics:\n  chatter:\n    type: std_msgs/msg/String\n", "mode: only 'normal' is supported"),
+    ([], "services:\n  add:\n    bidirectional: true\n", ":2: services: add: bidirectional: only topics go both ways"),
+    ([], "topics:\n  chatter:\n    colour: red\n", ":2: topics: chatter: unknown key 'colour'"),
+    ([], "topics:\n  chatter:\n    qos: {deadline: 5}\n", "qos: deadline: only 'auto' is supported"),
     ([], "from_domain: 999\ntopics:\n  chatter: {}\n", "topics: chatter: from_domain: expected a ROS domain id"),
+    ([], "colour: red\n", ":1: unknown key 'colour'"),
+    ([], "topics: [a\n", "not valid YAML"),
 ])
 def test_bad_bridges_are_one_line(tmp_path: Path, args: list[str], config: str | None, error: str) -> None:
     if config is not None:
@@ -141,3 +144,70 @@ def test_bad_bridges_are_one_line(tmp_path: Path, args: list[str], config: str |
         args = [*args, "--config", str(tmp_path / "bridge.yaml")]
     result = roc("bridge", *args, env=graph_env(100, tmp_path))
     assert result.returncode == 2 and error in result.stderr.splitlines()[0], result.stderr
+
+
+HEADER = "std_msgs/msg/Header"
+
+
+def _talker_and_listener(side: str) -> dict:
+    """A node that publishes /chatter headers stamped at publication (each one different) with
+    ``frame_id`` ``side``, and prints every /chatter message it receives."""
+    return {"name": f"node_{side}", "publishers": [{"topic": "chatter", "type": HEADER, "values": {"frame_id": side},
+                                                     "rate_hz": 20, "stamp_now": True}],
+            "subscribers": [{"topic": "chatter", "type": HEADER, "print": True}]}
+
+
+def test_both_ways_without_loops(tmp_path: Path) -> None:
+    """/chatter bridged both ways between two domains, each with a talker: every message reaches the
+    other domain once, and nothing the bridge publishes comes back to it."""
+    a = graph_env(100, tmp_path / "a")
+    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(110)}
+    nodes = start_nodes([[_talker_and_listener("a")]], a) + start_nodes([[_talker_and_listener("b")]], b)
+    bridge = _bridge("--from-domain", a["ROS_DOMAIN_ID"], "--to-domain", b["ROS_DOMAIN_ID"], "--bidirectional",
+                     "/chatter", "--format", "json", env=a)
+    try:
+        events = _events_until(bridge, "/chatter", 30)
+        while sum(e["event"] == "bridging" for e in events) < 2:
+            events.append(json.loads(_line(bridge, time.monotonic() + 30)))
+        assert sorted((e["from_domain"], e["to_domain"]) for e in events if e["event"] == "bridging") == sorted(
+            [(int(a["ROS_DOMAIN_ID"]), int(b["ROS_DOMAIN_ID"])), (int(b["ROS_DOMAIN_ID"]), int(a["ROS_DOMAIN_ID"]))])
+        deadline = time.monotonic() + 30
+        while True:  # a rates event once both directions carry messages (a loop would make it hundreds)
+            event = json.loads(_line(bridge, deadline))
+            if event["event"] == "rates" and len(event["rates"]) == 2 and min(event["rates"].values()) > 5:
+                break
+        assert max(event["rates"].values()) < 40, event
+        time.sleep(2)
+    finally:
+        assert _stop(bridge) == 130
+        stop_all(nodes)
+    for process, other in zip(nodes, ("b", "a")):
+        received = [line for line in process.stdout.read().splitlines() if line.startswith("{")]
+        assert len(received) == len(set(received)), "a message arrived twice"
+        assert sum(f"frame_id='{other}'" in line for line in received) > 20
+
+
+def test_a_service_and_an_action_are_served_in_the_other_domain(tmp_path: Path) -> None:
+    a = graph_env(100, tmp_path / "a")
+    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(110)}
+    server = start_nodes([[{"name": "server", "services": [
+        {"name": "echo_types", "type": "test_msgs/srv/BasicTypes", "echo": True}],
+        "actions": [{"name": "fibonacci", "step_seconds": 0.05}]}]], a)
+    bridge = _bridge("--from-domain", a["ROS_DOMAIN_ID"], "--to-domain", b["ROS_DOMAIN_ID"], "--service",
+                     "echo_types", "--action", "/fibonacci", env=a)
+    try:
+        announced = _bridging_lines(bridge, 6)
+        assert (f"bridging service /echo_types [test_msgs/srv/BasicTypes] domain {a['ROS_DOMAIN_ID']} -> "
+                f"{b['ROS_DOMAIN_ID']}\n") in announced
+        called = roc("service", "call", "/echo_types", "test_msgs/srv/BasicTypes",
+                     "{int32_value: 7, string_value: across}", "--format", "json", env=b)
+        assert called.returncode == 0, called.stderr
+        response = json.loads(called.stdout.splitlines()[-1])
+        assert (response["response"]["int32_value"], response["response"]["string_value"]) == (7, "across")
+        goal = roc("action", "send_goal", "/fibonacci", "test_msgs/action/Fibonacci", "{order: 5}", env=b)
+        assert goal.returncode == 0, goal.stderr
+        assert "sequence:\n- 0\n- 1\n- 1\n- 2\n- 3\n- 5\n" in goal.stdout
+        assert "Goal finished with status: SUCCEEDED" in goal.stdout
+    finally:
+        assert _stop(bridge) == 130
+        stop_all(server)

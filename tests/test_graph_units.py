@@ -156,3 +156,62 @@ def test_discovery_waits_for_a_quiet_graph_bounded_by_spin_time():
     assert 0.7 <= waited(FakeGraph(0.5), 0.2, 0.2) < 0.2 + EXTRA_SECONDS
     # Never quiet: stops at the period plus EXTRA_SECONDS.
     assert waited(FakeGraph(60), 0.1, 0.2) == pytest.approx(0.1 + EXTRA_SECONDS, abs=0.3)
+
+
+# ---- roc bridge: domain_bridge configs and the loop guard ------------------------------------------
+
+def test_a_domain_bridge_config_keeps_repeated_topics_and_reverses(tmp_path: Path) -> None:
+    """domain_bridge's own example names a topic several times; each entry is a route."""
+    from roc.commands.bridge import routes_from_config
+    from roc.ros.bridge import Route
+
+    config = tmp_path / "bridge.yaml"
+    config.write_text("name: my_bridge\nfrom_domain: 2\nto_domain: 3\ntopics:\n"
+                      "  chatter:\n    type: example_interfaces/msg/String\n    qos:\n      reliability: best_effort\n"
+                      "  chatter:\n    type: example_interfaces/msg/String\n    to_domain: 4\n"
+                      "  chatter:\n    type: example_interfaces/msg/String\n    reversed: True\n"
+                      "  chatter:\n    type: example_interfaces/msg/String\n    from_domain: 7\n    to_domain: 8\n"
+                      "    bidirectional: True\n"
+                      "  chatter:\n    type: example_interfaces/msg/String\n    remap: chitter\n"
+                      "services:\n  add_two_ints:\n    type: example_interfaces/srv/AddTwoInts\n    from_domain: 4\n"
+                      "actions:\n  fibonacci:\n    type: example_interfaces/action/Fibonacci\n    from_domain: 1\n")
+    string = "example_interfaces/msg/String"
+    assert routes_from_config(config) == [
+        Route("/chatter", 2, 3, string, qos={"reliability": "best_effort"}), Route("/chatter", 2, 4, string),
+        Route("/chatter", 3, 2, string), Route("/chatter", 7, 8, string), Route("/chatter", 8, 7, string),
+        Route("/chatter", 2, 3, string, "/chitter"),
+        Route("/add_two_ints", 4, 3, "example_interfaces/srv/AddTwoInts", kind="service"),
+        Route("/fibonacci", 1, 3, "example_interfaces/action/Fibonacci", kind="action")]
+
+
+def test_an_action_is_bridged_as_its_services_and_topics() -> None:
+    from roc.ros.bridge import Route, action_routes
+
+    parts = action_routes(Route("/fib", 1, 2, "test_msgs/action/Fibonacci", "/fob", kind="action"))
+    assert [(p.kind, p.name, p.target, p.type) for p in parts] == [
+        ("service", "/fib/_action/send_goal", "/fob/_action/send_goal", None),
+        ("service", "/fib/_action/cancel_goal", "/fob/_action/cancel_goal", None),
+        ("service", "/fib/_action/get_result", "/fob/_action/get_result", None),
+        ("topic", "/fib/_action/feedback", "/fob/_action/feedback", None),
+        ("topic", "/fib/_action/status", "/fob/_action/status", None)]
+
+
+def test_the_loop_guard_sets_roc_s_profile_or_checks_the_user_s(tmp_path: Path) -> None:
+    from roc.errors import UsageError
+    from roc.ros.bridge import IGNORE_LOCAL_PROFILE, Route, loop_guard, two_way
+
+    both = [Route("/x", 1, 2), Route("/x", 2, 1)]
+    assert two_way(both) == ["/x"] and two_way([Route("/x", 1, 2), Route("/x", 1, 3)]) == []
+    assert two_way([Route("*", 1, 2), Route("/y", 2, 1)]) == ["*", "/y"]
+    environment: dict[str, str] = {}
+    loop_guard(both, environment)
+    assert environment["FASTRTPS_DEFAULT_PROFILES_FILE"] == str(IGNORE_LOCAL_PROFILE)
+    assert "<name>fastdds.ignore_local_endpoints</name>" in IGNORE_LOCAL_PROFILE.read_text()
+    theirs = tmp_path / "profile.xml"
+    theirs.write_text("<dds/>")
+    loop_guard([Route("/x", 1, 2)], mine := {"FASTRTPS_DEFAULT_PROFILES_FILE": str(theirs)})
+    assert mine == {"FASTRTPS_DEFAULT_PROFILES_FILE": str(theirs)}  # one way: the user's profile is enough
+    with pytest.raises(UsageError, match=f"{theirs}: bridging /x both ways needs the participant property"):
+        loop_guard(both, {"FASTRTPS_DEFAULT_PROFILES_FILE": str(theirs)})
+    with pytest.raises(UsageError, match="/x: bridging both ways needs Fast DDS"):
+        loop_guard(both, {"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"})

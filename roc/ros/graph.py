@@ -18,6 +18,7 @@ import rclpy
 from rclpy.action import graph as action_graph
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
@@ -35,6 +36,7 @@ QUIET_SECONDS = 0.3
 EXTRA_SECONDS = 1.0
 POLL_SECONDS = 0.05
 SERVICE_TIMEOUT = 5.0
+SPIN_SLICE = 0.1  # seconds an executor waits before it looks whether the graph is closing
 
 
 class NotFound(RocError):
@@ -82,26 +84,39 @@ class Graph:
     """A hidden rclpy node in its own context, spun in a background thread (for service calls); in
     ``domain_id`` when given, else in the environment's ROS domain."""
 
-    def __init__(self, node_name: str | None = None, domain_id: int | None = None) -> None:
+    def __init__(self, node_name: str | None = None, domain_id: int | None = None, events: bool = False) -> None:
+        """``events``: spin with rclpy's C++ EventsExecutor, which takes a message in a fraction of the
+        Python executor's time (at 5 kHz: no loss and 0.2 ms instead of 10 % loss and 60 ms here)."""
         self.context = Context()
         rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO, domain_id=domain_id)
         self.node = Node(node_name or f"_roc_{os.getpid()}", context=self.context, start_parameter_services=False,
                          enable_rosout=False)
-        self.executor = SingleThreadedExecutor(context=self.context)
+        self.events = events
+        self.executor = EventsExecutor(context=self.context) if events else SingleThreadedExecutor(context=self.context)
+        self._stopping = threading.Event()
         self.executor.add_node(self.node)
         self._spinner = threading.Thread(target=self._spin, daemon=True)
         self._spinner.start()
 
     def _spin(self) -> None:
         try:
-            self.executor.spin()
+            while not self._stopping.is_set():
+                self.executor.spin_once(timeout_sec=SPIN_SLICE)
         except Exception:  # noqa: BLE001 - the context was shut down under it
             pass
 
     def close(self) -> None:
-        rclpy.try_shutdown(context=self.context)
+        """Stop spinning, then shut down. The EventsExecutor deadlocks if its context is shut down while
+        it spins (its shutdown callback waits for the spin), and may miss a wake that comes before it
+        waits (so it waits SPIN_SLICE at most); the Python executor wakes for the shutdown only."""
+        self._stopping.set()
+        if self.events:
+            self.executor.wake()
+        else:
+            rclpy.try_shutdown(context=self.context)
         self._spinner.join(timeout=2)
         self.executor.shutdown(timeout_sec=1)
+        rclpy.try_shutdown(context=self.context)
         self.node.destroy_node()
 
     # -- discovery ------------------------------------------------------------------------------------
