@@ -9,11 +9,14 @@ rclpy made for it. It is not in any executor: ``take`` is polled.
 from __future__ import annotations
 
 import ctypes
+import functools
 from typing import Any
 
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.qos import QoSProfile
 from rclpy.type_support import check_is_valid_msg_type
+
+from roc.errors import RocError
 
 RCL_RET_OK = 0
 RCL_RET_SUBSCRIPTION_TAKE_FAILED = 401  # nothing to take
@@ -40,6 +43,7 @@ class _Info(ctypes.Structure):  # rmw_message_info_t
                 ("publisher_gid", _Gid), ("from_intra_process", ctypes.c_bool)]
 
 
+@functools.cache
 def _libraries() -> tuple[ctypes.CDLL, ctypes.CDLL]:
     """librcl and librcutils as rclpy loaded them (dlopen finds a loaded library by its name)."""
     rcl, rcutils = ctypes.CDLL("librcl.so"), ctypes.CDLL("librcutils.so")
@@ -70,7 +74,7 @@ class GidSubscription:
         allocator = self._rcutils.rcutils_get_default_allocator()
         if self._rcutils.rcutils_uint8_array_init(ctypes.byref(self._buffer), 0, ctypes.byref(allocator)) != RCL_RET_OK:
             self._handle.destroy_when_not_in_use()
-            raise MemoryError("cannot allocate a serialized message buffer")
+            raise RocError("cannot allocate a buffer for serialized messages")
 
     def take(self, most: int) -> list[tuple[bytes, dict[str, Any]]]:
         """Up to ``most`` messages waiting, oldest first."""
@@ -82,7 +86,7 @@ class GidSubscription:
             if result == RCL_RET_SUBSCRIPTION_TAKE_FAILED:
                 break
             if result != RCL_RET_OK:
-                raise RuntimeError(f"rcl_take_serialized_message failed ({result})")
+                raise RocError(f"rcl_take_serialized_message failed ({result})")
             taken.append((ctypes.string_at(self._buffer.buffer, self._buffer.buffer_length),
                           {"gid": gid_text(info.publisher_gid.data), "received_timestamp": info.received_timestamp,
                            "publication_sequence_number": info.publication_sequence_number}))
