@@ -116,6 +116,23 @@ def test_monitor_gives_rate_delay_and_node_per_frame(tree) -> None:
     assert last["lens"]["rate"] == pytest.approx(10, rel=0.25) and 0 <= last["base_link"]["delay_average"] < 1
 
 
+def test_a_frame_sent_by_two_nodes_names_both(tree) -> None:
+    """A conflict a ROS user wants to see: lens also published by roc frame pub (its own node, /_roc_<pid>)."""
+    pub = subprocess.Popen([str(BIN / "roc"), "frame", "pub", "camera", "lens", "--z", "2", "--rate", "10",
+                            "--duration", "20"], env=tree, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    both, deadline = sorted([f"/_roc_{pub.pid}", "/tf_camera"]), time.monotonic() + 30
+    try:
+        assert pub.stdout.readline().startswith("publishing camera -> lens on /tf at 10 Hz")
+        while True:  # (until the daemon has discovered the fresh publisher)
+            rows = json.loads(frame("list", "--format", "json", "--duration", "2", env=tree).stdout)
+            lens = {row["frame"]: row["publishers"] for row in rows}["lens"]
+            if lens == both or time.monotonic() > deadline:
+                break
+    finally:
+        stop_process(pub)
+    assert lens == both
+
+
 def test_pub_reaches_a_real_subscriber_and_ctrl_c_stops_it(sourced) -> None:
     listener = subprocess.Popen([sys.executable, str(TF_NODE), "listen"], env=sourced, stdout=subprocess.PIPE,
                                 stderr=subprocess.DEVNULL, text=True)
