@@ -27,13 +27,15 @@ class Listener:
     """The buffer, the delays seen (reception minus stamp) and the nodes that sent each child frame
     (more than one when several nodes publish the same frame)."""
 
-    def __init__(self, use_daemon: bool = True):
+    def __init__(self, use_daemon: bool = True, early: bool = False):
+        """``early``: a daemon that is starting serves it before its discovery period (for a verb that
+        waits until it has heard what it needs, not for a fixed time)."""
         require_tf2_msgs()
         self.buffer = Buffer()
         self.delays: dict[str, list[float]] = {}
         self.publishers: dict[str, set[str]] = {}
         self._subscribed = False
-        self._events = stream("frames", {}, use_daemon=use_daemon, heartbeats=True)
+        self._events = stream("frames", {"early": early}, use_daemon=use_daemon, heartbeats=True)
 
     def listen(self, done: Callable[[], bool] = lambda: False, seconds: float | None = None) -> bool:
         """Take in transforms until ``done()`` (True) or ``seconds`` have passed (False), counted from

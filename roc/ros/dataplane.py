@@ -260,10 +260,12 @@ def stats(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
 
 
 def frames(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
-    """Subscribe to /tf (QoS following its publishers, depth 100) and /tf_static (transient local, as
-    tf2's static listener does) and yield ``messages {messages: [{static, data, received, publisher}]}``
-    batches of TFMessage CDR (``publisher``: the sending node's full name, null while the graph does not
-    know it), ``subscribed`` first and heartbeats in between."""
+    """Subscribe to /tf (QoS following the publishers known, else reliable as tf2's listener; depth
+    100) and /tf_static (transient local, as tf2's static listener does) and yield ``messages
+    {messages: [{static, data, received, publisher}]}`` batches of TFMessage CDR (``publisher``: the
+    sending node's full name, null while the graph does not know it), ``subscribed`` first and
+    heartbeats in between. It needs no discovered graph: with ``early``, a daemon that is starting
+    serves it before its discovery period."""
     cls = message_class(TF_TYPE)
     dynamic = qos_profile({"profile": "default", "depth": 100}, graph.node.get_publishers_info_by_topic("/tf"))
     static = qos_profile({"profile": "default", "depth": 100, "durability": "transient_local", "reliability": "reliable"})
