@@ -47,7 +47,8 @@ def test_powershell_scripts(example):
     install = example / "install"
     for script in install.rglob("*.ps1"):
         parse(script.read_text())
-    check_package_scripts(install, ["demo_interfaces", "demo_core", "demo_tools", "demo_py", "demo_plain"], merged=False)
+    check_package_scripts(install, ["demo_interfaces", "demo_core", "demo_tools", "demo_py", "demo_plain", "tf2_msgs"],
+                          merged=False)
 
 
 def test_python_node_messages_arrive(example):
@@ -69,6 +70,23 @@ def test_python_node_messages_arrive(example):
     assert listener.returncode == 0, output
     received = [line for line in output.splitlines() if "Received reading" in line]
     assert len(received) == 3 and all("celsius" in line for line in received), output
+
+
+def test_frame_verbs_work_in_the_sourced_example(example):
+    """The example's tf2_msgs is what roc frame needs: a static transform published and looked up."""
+    env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin", "ROS_DOMAIN_ID": ros_domain_id(60),
+           "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST", "RMW_IMPLEMENTATION": "rmw_fastrtps_cpp"}
+    source = "set -eu; source install/setup.bash; exec "
+    pub = subprocess.Popen(["bash", "-c", source + "roc frame pub map odom --x 1 --yaw 90 --degrees"], cwd=example,
+                           env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        echo = subprocess.run(["bash", "-c", source + "roc frame echo map odom --once --no-daemon --timeout 30"],
+                              cwd=example, env=env, capture_output=True, text=True, timeout=90)
+    finally:
+        stop_process(pub)
+    assert echo.returncode == 0, echo.stderr
+    assert echo.stdout.splitlines()[1:3] == ["- Translation: [1.000, 0.000, 0.000]",
+                                             "- Rotation: in Quaternion (xyzw) [0.000, 0.000, 0.707, 0.707]"]
 
 
 @pytest.mark.colcon

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from pathlib import Path
 
 import numpy
@@ -83,6 +84,20 @@ def test_convert_prints_as_tf2_echo_and_json() -> None:
 def test_convert_errors(args: list[str], error: str) -> None:
     result = _convert(*args)
     assert result.returncode == 2 and result.stderr.startswith(f"roc: error: {error}")
+
+
+def test_pictures_without_graphviz_are_one_error_before_any_listening(tmp_path: Path, monkeypatch) -> None:
+    """No dot and no graphviz-pure on PATH nor next to Python: one line, nothing written; graphviz-pure
+    alone draws no PDF."""
+    monkeypatch.setattr(sys, "executable", str(tmp_path / "python"))
+    env = tool_environment(PATH=str(tmp_path))
+    drawn = run_roc_inprocess(["frame", "tree", "--output", "tf.png"], cwd=tmp_path, env=env)
+    assert (drawn.returncode, drawn.stderr) == (1, "roc: error: --output tf.png: Graphviz's 'dot' program is not "
+                                                   "installed (apt install graphviz; or pip install graphviz-pure, "
+                                                   "which draws .svg and .png); or write a .dot file\n")
+    assert not (tmp_path / "tf.png").exists()
+    (tmp_path / "graphviz-pure").symlink_to(Path(sys.prefix, "bin", "graphviz-pure"))
+    assert run_roc_inprocess(["frame", "tree", "--output", "tf.pdf"], cwd=tmp_path, env=env).returncode == 1
 
 
 def _tree():

@@ -1,4 +1,4 @@
-"""roc frame verbs on a live tf tree: tf2_msgs built by roc from workspaces/fixtures/tf, sourced, and a
+"""roc frame verbs on a live tf tree: tf2_msgs built by roc from the example workspace, sourced, and a
 tree published by real rclpy nodes (tests/tf_node.py): map->odom (static), odom->base_link (20 Hz,
 yaw 90 degrees), base_link->laser (static), and a second tree camera->lens."""
 
@@ -8,6 +8,7 @@ import json
 import contextlib
 import os
 import queue
+import shutil
 import signal
 import subprocess
 import sys
@@ -16,7 +17,7 @@ import time
 from pathlib import Path
 
 import pytest
-from build_helpers import BIN, copy_fixture, roc, stop_process
+from build_helpers import BIN, REPO, roc, stop_process
 from graph_helpers import graph_env, stop_daemon
 
 pytestmark = pytest.mark.slow
@@ -26,7 +27,8 @@ TF_NODE = Path(__file__).resolve().parent / "tf_node.py"
 @pytest.fixture(scope="module")
 def sourced(tmp_path_factory):
     """A graph environment with the built tf2_msgs sourced."""
-    workspace = copy_fixture("tf", tmp_path_factory.mktemp("tf") / "ws")
+    workspace = tmp_path_factory.mktemp("tf")
+    shutil.copytree(REPO / "workspaces" / "example" / "src" / "tf2_msgs", workspace / "src" / "tf2_msgs")
     built = roc("work", "build", cwd=workspace)
     assert built.returncode == 0, built.stdout + built.stderr
     env = graph_env(65, tmp_path_factory.mktemp("runtime"))
@@ -40,11 +42,15 @@ def sourced(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def tree(sourced):
-    process = subprocess.Popen([sys.executable, str(TF_NODE), "publish"], env=sourced, stdout=subprocess.PIPE,
-                               stderr=subprocess.DEVNULL, text=True)
-    assert process.stdout.readline().strip() == "ready"
-    yield sourced
-    stop_process(process)
+    """Two tf publisher nodes: /tf_publish (map->odom->base_link->laser), /tf_camera (camera->lens on /tf)."""
+    processes = [subprocess.Popen([sys.executable, str(TF_NODE), mode], env=sourced, stdout=subprocess.PIPE,
+                                  stderr=subprocess.DEVNULL, text=True) for mode in ("publish", "camera")]
+    try:
+        assert [process.stdout.readline().strip() for process in processes] == ["ready", "ready"]
+        yield sourced
+    finally:
+        for process in processes:
+            stop_process(process)
 
 
 def frame(*args: str, env: dict[str, str]) -> subprocess.CompletedProcess:
@@ -78,19 +84,53 @@ def test_list_and_tree(tree, tmp_path: Path) -> None:
     assert sorted(rows) == ["base_link", "camera", "laser", "lens", "map", "odom"]
     assert (rows["odom"]["parent"], rows["odom"]["static"]) == ("map", True)
     assert rows["base_link"]["static"] is False and rows["base_link"]["rate"] == pytest.approx(20, rel=0.15)
-    assert rows["base_link"]["publishers"] == ["/tf_publish"] and rows["map"]["parent"] is None
+    assert rows["map"]["parent"] is None and rows["map"]["publishers"] == []
+    # each frame names the node that sent it, although both nodes publish /tf
+    assert {frame: row["publishers"] for frame, row in rows.items() if row["parent"]} == {
+        "odom": ["/tf_publish"], "base_link": ["/tf_publish"], "laser": ["/tf_publish"], "lens": ["/tf_camera"]}
     text = frame("tree", "--duration", "1", env=tree).stdout.splitlines()
+    assert text[1].endswith(", /tf_camera]") and text[3] == "└── odom [static, /tf_publish]"
     assert [line.split(" [")[0] for line in text] == ["camera", "└── lens", "map", "└── odom", "    └── base_link",
                                                       "        └── laser"]
     dot = tmp_path / "tf.dot"
     assert frame("tree", "--duration", "1", "--output", str(dot), env=tree).returncode == 0
     assert '"odom" -> "base_link" [label="' in dot.read_text() and dot.read_text().startswith("digraph tf {")
-    png = tmp_path / "tf.png"
+    png, svg = tmp_path / "tf.png", tmp_path / "tf.svg"  # drawn by graphviz-pure (the test extra) or dot
     drawn = frame("tree", "--duration", "1", "--output", str(png), env=tree)
-    if drawn.returncode == 0:
-        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    else:
-        assert "Graphviz's 'dot' program is not installed" in drawn.stderr and not png.exists()
+    assert drawn.returncode == 0, drawn.stderr
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    drawn = frame("tree", "--duration", "1", "--output", str(svg), env=tree)
+    assert drawn.returncode == 0, drawn.stderr
+    assert "<svg" in svg.read_text() and ">base_link</text>" in svg.read_text()
+
+
+def test_monitor_gives_rate_delay_and_node_per_frame(tree) -> None:
+    result = frame("monitor", "--duration", "2.5", "--format", "json", env=tree)
+    assert result.returncode == 0, result.stderr
+    last = {}
+    for line in result.stdout.splitlines():
+        row = json.loads(line)
+        last[row["frame"]] = row
+    assert sorted(last) == ["base_link", "lens"]  # dynamic frames only
+    assert (last["base_link"]["publishers"], last["lens"]["publishers"]) == (["/tf_publish"], ["/tf_camera"])
+    assert last["lens"]["rate"] == pytest.approx(10, rel=0.25) and 0 <= last["base_link"]["delay_average"] < 1
+
+
+def test_a_frame_sent_by_two_nodes_names_both(tree) -> None:
+    """A conflict a ROS user wants to see: lens also published by roc frame pub (its own node, /_roc_<pid>)."""
+    pub = subprocess.Popen([str(BIN / "roc"), "frame", "pub", "camera", "lens", "--z", "2", "--rate", "10",
+                            "--duration", "20"], env=tree, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    both, deadline = sorted([f"/_roc_{pub.pid}", "/tf_camera"]), time.monotonic() + 30
+    try:
+        assert pub.stdout.readline().startswith("publishing camera -> lens on /tf at 10 Hz")
+        while True:  # (until the daemon has discovered the fresh publisher)
+            rows = json.loads(frame("list", "--format", "json", "--duration", "2", env=tree).stdout)
+            lens = {row["frame"]: row["publishers"] for row in rows}["lens"]
+            if lens == both or time.monotonic() > deadline:
+                break
+    finally:
+        stop_process(pub)
+    assert lens == both
 
 
 def test_pub_reaches_a_real_subscriber_and_ctrl_c_stops_it(sourced) -> None:

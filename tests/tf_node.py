@@ -1,7 +1,8 @@
 """A tf publisher for the frame tests (needs tf2_msgs installed):
 
-    python tf_node.py publish   # /tf_static: map->odom (x 1), base_link->laser (y 1), camera->lens (z 1);
+    python tf_node.py publish   # /tf_static: map->odom (x 1), base_link->laser (y 1);
                                 # /tf at 20 Hz: odom->base_link (yaw 90 degrees)
+    python tf_node.py camera    # a second node on /tf, at 10 Hz: camera->lens (z 1)
     python tf_node.py listen    # prints each transform heard on /tf_static as a JSON line
 
 Prints "ready" once its endpoints exist, then spins until killed.
@@ -37,11 +38,13 @@ def main() -> None:
     if sys.argv[1] == "publish":
         static = node.create_publisher(TFMessage, "/tf_static", STATIC)
         static.publish(TFMessage(transforms=[stamped(node, "map", "odom", (1.0, 0.0, 0.0)),
-                                             stamped(node, "base_link", "laser", (0.0, 1.0, 0.0)),
-                                             stamped(node, "camera", "lens", (0.0, 0.0, 1.0))]))
+                                             stamped(node, "base_link", "laser", (0.0, 1.0, 0.0))]))
         dynamic = node.create_publisher(TFMessage, "/tf", 100)
         node.create_timer(0.05, lambda: dynamic.publish(
             TFMessage(transforms=[stamped(node, "odom", "base_link", yaw=math.pi / 2)])))
+    elif sys.argv[1] == "camera":
+        dynamic = node.create_publisher(TFMessage, "/tf", 100)
+        node.create_timer(0.1, lambda: dynamic.publish(TFMessage(transforms=[stamped(node, "camera", "lens", (0.0, 0.0, 1.0))])))
     else:
         def heard(message: TFMessage) -> None:
             for t in message.transforms:

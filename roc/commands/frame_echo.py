@@ -29,7 +29,7 @@ def run(args: argparse.Namespace) -> int:
 
     if args.rate <= 0:
         raise UsageError(f"--rate: must be above 0 Hz, got {args.rate:g}")
-    listener = Listener(use_daemon=not args.no_daemon)
+    listener = Listener(use_daemon=not args.no_daemon, early=True)
     last_error: list[str] = []
 
     def available() -> bool:

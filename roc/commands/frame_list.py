@@ -1,5 +1,5 @@
 """roc frame list: every tf frame with its parent, static or dynamic, rate, the age of its latest
-transform and the nodes publishing tf, after listening --duration seconds."""
+transform and the node(s) that sent it, after listening --duration seconds."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_discovery_arguments(parser)
 
 
-def frame_rows(listener, publishers: dict[str, list[str]]) -> list[dict]:
+def frame_rows(listener) -> list[dict]:
     """One dict per frame (roots too, with no parent)."""
     now = time.time_ns()
     rows = []
@@ -29,23 +29,8 @@ def frame_rows(listener, publishers: dict[str, list[str]]) -> list[dict]:
         age = None if link.static else (now - link.stamps[-1]) * 1e-9
         rows.append({"frame": frame, "parent": link.parent, "static": link.static,
                      "rate": None if link.static else link.rate(), "age": age,
-                     "publishers": publishers["/tf_static" if link.static else "/tf"]})
+                     "publishers": sorted(listener.publishers.get(frame, ()))})
     return rows
-
-
-def tf_publishers(use_daemon: bool) -> dict[str, list[str]]:
-    """The nodes publishing /tf and /tf_static (tf messages do not say which node sent a frame)."""
-    from roc.errors import RocError
-    from roc.ros.client import query
-
-    found = {}
-    for topic in ("/tf", "/tf_static"):
-        try:
-            info = query("topic_endpoints", {"topic": topic}, use_daemon=use_daemon, spin_time=1.0)
-            found[topic] = sorted({f"{p['node_namespace'].rstrip('/')}/{p['node_name']}" for p in info["publishers"]})
-        except RocError:
-            found[topic] = []
-    return found
 
 
 def heard_frames(args: argparse.Namespace) -> list[dict]:
@@ -57,7 +42,7 @@ def heard_frames(args: argparse.Namespace) -> list[dict]:
         listener.listen(seconds=args.duration)
     finally:
         listener.close()
-    return frame_rows(listener, tf_publishers(not args.no_daemon))
+    return frame_rows(listener)
 
 
 def run(args: argparse.Namespace) -> int:

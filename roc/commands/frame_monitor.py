@@ -1,5 +1,5 @@
-"""roc frame monitor: per dynamic frame, the rate, the delay (reception minus stamp) and the nodes
-publishing tf, every second (like tf2_monitor); with SOURCE TARGET, only the frames between them."""
+"""roc frame monitor: per dynamic frame, the rate, the delay (reception minus stamp) and the node(s)
+that sent it, every second (like tf2_monitor); with SOURCE TARGET, only the frames between them."""
 
 from __future__ import annotations
 
@@ -8,7 +8,6 @@ import statistics
 import time
 
 from roc.cli.options import add_discovery_arguments, add_format_argument
-from roc.commands.frame_list import tf_publishers
 from roc.errors import UsageError
 from roc.frames.buffer import TransformUnavailable
 from roc.render import json_line, print_text, table_lines
@@ -32,7 +31,7 @@ def _between(buffer, source: str, target: str) -> set[str] | None:
     return {*up_source[:up_source.index(common)], *up_target[:up_target.index(common)]}
 
 
-def report(listener, publishers: list[str], only: set[str] | None) -> list[dict]:
+def report(listener, only: set[str] | None) -> list[dict]:
     rows = []
     for frame, link in sorted(listener.buffer.links.items()):
         if link.static or (only is not None and frame not in only):
@@ -40,7 +39,8 @@ def report(listener, publishers: list[str], only: set[str] | None) -> list[dict]
         delays = listener.delays.get(frame, [])[-100:]
         rows.append({"frame": frame, "parent": link.parent, "rate": link.rate(),
                      "delay_average": statistics.fmean(delays) if delays else None,
-                     "delay_max": max(delays) if delays else None, "publishers": publishers})
+                     "delay_max": max(delays) if delays else None,
+                     "publishers": sorted(listener.publishers.get(frame, ()))})
     return rows
 
 
@@ -50,13 +50,12 @@ def run(args: argparse.Namespace) -> int:
     if len(args.frames) not in (0, 2):
         raise UsageError("give no frame, or SOURCE TARGET")
     listener = Listener(use_daemon=not args.no_daemon)
-    publishers = tf_publishers(not args.no_daemon)["/tf"]
     deadline = time.monotonic() + args.duration if args.duration is not None else None
     try:
         while deadline is None or time.monotonic() < deadline:
             listener.listen(seconds=1.0)
             only = _between(listener.buffer, *args.frames) if args.frames else None
-            rows = report(listener, publishers, only)
+            rows = report(listener, only)
             if args.format == "json":
                 print_text("".join(json_line(row) for row in rows))
                 continue

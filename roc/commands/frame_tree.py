@@ -1,11 +1,12 @@
 """roc frame tree: the tf tree as text, or as Graphviz DOT, SVG, PNG or PDF (--output FILE, by its
-extension; pictures need Graphviz's ``dot``), each edge with its rate and publishers."""
+extension; pictures need Graphviz's ``dot`` or graphviz-pure), each edge with its rate and publishers."""
 
 from __future__ import annotations
 
 import argparse
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 from roc.cli.options import add_discovery_arguments
@@ -60,18 +61,27 @@ def dot_text(rows: list[dict]) -> str:
     return "\n".join([*lines, "}"]) + "\n"
 
 
-def write_picture(path: Path, dot: str) -> None:
-    """Render DOT with Graphviz into ``path`` (atomically)."""
-    program = shutil.which("dot")
-    if program is None:
-        raise RocError(f"--output {path}: Graphviz's 'dot' program is not installed (e.g. apt install graphviz); "
-                       "or write a .dot file")
+def graphviz(path: Path) -> str:
+    """The program that draws ``path``: Graphviz's ``dot``, else graphviz-pure (its pure-Rust port, a
+    pip package, so also looked for next to this Python: a venv's bin is not always on PATH), which
+    writes no PDF."""
+    here = str(Path(sys.executable).parent)
+    for name in ("dot", "graphviz-pure"):
+        program = shutil.which(name) or shutil.which(name, path=here)
+        if program and not (name == "graphviz-pure" and path.suffix.lower() == ".pdf"):
+            return program
+    raise RocError(f"--output {path}: Graphviz's 'dot' program is not installed (apt install graphviz; or "
+                   "pip install graphviz-pure, which draws .svg and .png); or write a .dot file")
+
+
+def write_picture(program: str, path: Path, dot: str) -> None:
+    """Render DOT with ``program`` into ``path`` (atomically)."""
     temporary = path.with_name(f".{path.name}.tmp")
-    done = subprocess.run([program, f"-T{path.suffix[1:]}", "-o", str(temporary)], input=dot, text=True,
+    done = subprocess.run([program, f"-T{path.suffix[1:].lower()}", "-o", str(temporary)], input=dot, text=True,
                           capture_output=True)
     if done.returncode != 0:
         temporary.unlink(missing_ok=True)
-        raise RocError(f"--output {path}: dot failed: {done.stderr.strip()}")
+        raise RocError(f"--output {path}: {Path(program).name} failed: {done.stderr.strip()}")
     temporary.replace(path)
 
 
@@ -79,11 +89,12 @@ def run(args: argparse.Namespace) -> int:
     suffix = args.output.suffix.lower() if args.output else ""
     if args.output and suffix not in (".dot", ".gv", *PICTURES):
         raise UsageError(f"--output {args.output}: use a .dot, .gv, .svg, .png or .pdf file name")
+    program = graphviz(args.output) if suffix in PICTURES else None  # before listening: fail at once
     rows = heard_frames(args)
     if args.output is None:
         print_lines(tree_lines(rows) or ["no tf frames heard"])
-    elif suffix in PICTURES:
-        write_picture(args.output, dot_text(rows))
+    elif program:
+        write_picture(program, args.output, dot_text(rows))
     else:
         write_text_atomic(args.output, dot_text(rows))
     return 0

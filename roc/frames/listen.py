@@ -19,27 +19,35 @@ def require_tf2_msgs() -> None:
         message_class(TF_TYPE)
     except UnknownTypeError:
         raise UsageError("tf2_msgs is not installed (the ROS 2 wheels from PyPI lack it): source a ROS "
-                         "install that has it, or build the tf2_msgs package of roc's "
-                         "workspaces/fixtures/tf with 'roc work build' and source its install/setup.bash") from None
+                         "install that has it, or build roc's example workspace (workspaces/example, which has a "
+                         "tf2_msgs package) with 'roc work build' and source its install/setup.bash") from None
 
 
 class Listener:
-    """The buffer and the delays seen (reception minus stamp, per child frame)."""
+    """The buffer, the delays seen (reception minus stamp) and the nodes that sent each child frame
+    (more than one when several nodes publish the same frame)."""
 
-    def __init__(self, use_daemon: bool = True):
+    def __init__(self, use_daemon: bool = True, early: bool = False):
+        """``early``: a daemon that is starting serves it before its discovery period (for a verb that
+        waits until it has heard what it needs, not for a fixed time)."""
         require_tf2_msgs()
         self.buffer = Buffer()
         self.delays: dict[str, list[float]] = {}
-        self._events = stream("frames", {}, use_daemon=use_daemon, heartbeats=True)
+        self.publishers: dict[str, set[str]] = {}
+        self._subscribed = False
+        self._events = stream("frames", {"early": early}, use_daemon=use_daemon, heartbeats=True)
 
     def listen(self, done: Callable[[], bool] = lambda: False, seconds: float | None = None) -> bool:
-        """Take in transforms until ``done()`` (True) or ``seconds`` have passed (False)."""
+        """Take in transforms until ``done()`` (True) or ``seconds`` have passed (False), counted from
+        the subscription (a cold daemon takes a while to start)."""
         from roc.ros.dataplane import decode
 
-        deadline = time.monotonic() + seconds if seconds is not None else None
+        start = time.monotonic() if self._subscribed else None
         if done():
             return True
         for event in self._events:
+            if event["event"] == "subscribed":
+                self._subscribed, start = True, time.monotonic()
             for message in event.get("messages", ()):
                 for stamped in decode(TF_TYPE, message["data"]).transforms:
                     stamp = stamped.header.stamp.sec * 1_000_000_000 + stamped.header.stamp.nanosec
@@ -47,11 +55,14 @@ class Listener:
                     received = message["received"] or time.time_ns()
                     self.buffer.add(stamped.header.frame_id, stamped.child_frame_id, stamp,
                                     Transform((t.x, t.y, t.z), (r.x, r.y, r.z, r.w)), message["static"], received)
+                    child = stamped.child_frame_id.lstrip("/")
+                    if message.get("publisher"):
+                        self.publishers.setdefault(child, set()).add(message["publisher"])
                     if not message["static"]:
-                        self.delays.setdefault(stamped.child_frame_id.lstrip("/"), []).append((received - stamp) * 1e-9)
+                        self.delays.setdefault(child, []).append((received - stamp) * 1e-9)
             if done():
                 return True
-            if deadline is not None and time.monotonic() >= deadline:
+            if seconds is not None and start is not None and time.monotonic() - start >= seconds:
                 return False
         return False
 

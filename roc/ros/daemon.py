@@ -28,7 +28,8 @@ class Daemon:
         self.path = path
         self.last_request = time.monotonic()
         self.stopping = threading.Event()
-        self.ready = threading.Event()
+        self.created = threading.Event()  # the graph participant exists
+        self.ready = threading.Event()  # ... and has had its discovery period
         self.graph = None
         self.started = time.time()
 
@@ -73,6 +74,7 @@ class Daemon:
         from roc.ros.graph import Graph
 
         self.graph = Graph()
+        self.created.set()
         self.graph.wait_for_discovery()
         self.ready.set()
 
@@ -111,11 +113,14 @@ class Daemon:
             elif not isinstance(method, str):
                 raise RocError("a request needs a 'method'")
             else:
-                if not self.ready.wait(30):
+                params = request.get("params") or {}
+                # tf listening that waits for what it needs (frame echo) can start before the discovery
+                # period: its subscriptions match publishers as they are found, as tf2's listener does
+                early = method == "frames" and params.get("early")
+                if not (self.created if early else self.ready).wait(30):
                     raise RocError("the daemon's graph participant did not start")
                 from roc.ros.streams import STREAMS
 
-                params = request.get("params") or {}
                 if method in STREAMS:
                     yield from STREAMS[method](self.graph, params)
                     result = None

@@ -30,11 +30,14 @@ from rclpy.qos import (
 from rclpy.serialization import deserialize_message, serialize_message
 
 from roc.errors import RocError
+from roc.ros.gid_take import GidSubscription, gid_text
+from roc.ros.graph import full_name
 from roc.ros.types import TF_TYPE, message_class
 
 HEARTBEAT_SECONDS = 0.5
 MAX_BATCH = 1000  # messages in one ``messages`` event
 POLL_SECONDS = 0.05
+TAKE_POLL_SECONDS = 0.01  # frames: how often waiting tf messages are taken
 _POLICIES = {"history": HistoryPolicy, "reliability": ReliabilityPolicy, "durability": DurabilityPolicy,
              "liveliness": LivelinessPolicy}
 
@@ -257,30 +260,51 @@ def stats(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
 
 
 def frames(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
-    """Subscribe to /tf (QoS following its publishers, depth 100) and /tf_static (transient local, as
-    tf2's static listener does) and yield ``messages {messages: [{static, data, received}]}`` batches
-    of TFMessage CDR, ``subscribed`` first and heartbeats in between."""
+    """Subscribe to /tf (QoS following the publishers known, else reliable as tf2's listener; depth
+    100) and /tf_static (transient local, as tf2's static listener does) and yield ``messages
+    {messages: [{static, data, received, publisher}]}`` batches of TFMessage CDR (``publisher``: the
+    sending node's full name, null while the graph does not know it), ``subscribed`` first and
+    heartbeats in between. It needs no discovered graph: with ``early``, a daemon that is starting
+    serves it before its discovery period."""
     cls = message_class(TF_TYPE)
-    arrived: queue.SimpleQueue = queue.SimpleQueue()
     dynamic = qos_profile({"profile": "default", "depth": 100}, graph.node.get_publishers_info_by_topic("/tf"))
     static = qos_profile({"profile": "default", "depth": 100, "durability": "transient_local", "reliability": "reliable"})
-    subscriptions = [
-        graph.node.create_subscription(cls, "/tf", lambda data, info: arrived.put((False, data, info)), dynamic, raw=True),
-        graph.node.create_subscription(cls, "/tf_static", lambda data, info: arrived.put((True, data, info)), static,
-                                       raw=True)]
+    subscriptions = {"/tf": GidSubscription(graph.node, cls, "/tf", dynamic)}
+    subscriptions["/tf_static"] = GidSubscription(graph.node, cls, "/tf_static", static)
+    nodes = PublisherNames(graph)
     try:
         yield {"event": "subscribed", "type": TF_TYPE}
+        quiet_since = time.monotonic()
         while True:
-            try:
-                batch = [arrived.get(timeout=HEARTBEAT_SECONDS)]
-            except queue.Empty:
+            messages = [{"static": topic == "/tf_static", "data": base64.b64encode(data).decode(),
+                         "received": info["received_timestamp"], "publisher": nodes.name(topic, info["gid"])}
+                        for topic, subscription in subscriptions.items() for data, info in subscription.take(MAX_BATCH)]
+            if messages:
+                yield {"event": "messages", "messages": messages}
+                quiet_since = time.monotonic()
+            elif time.monotonic() - quiet_since >= HEARTBEAT_SECONDS:
                 yield {"event": "heartbeat"}
-                continue
-            while len(batch) < MAX_BATCH and not arrived.empty():
-                batch.append(arrived.get())
-            yield {"event": "messages", "messages": [
-                {"static": is_static, "data": base64.b64encode(data).decode(), "received": info.get("received_timestamp")}
-                for is_static, data, info in batch]}
+                quiet_since = time.monotonic()
+            else:
+                time.sleep(TAKE_POLL_SECONDS)
     finally:
-        for subscription in subscriptions:
-            graph.node.destroy_subscription(subscription)
+        for subscription in subscriptions.values():
+            subscription.destroy()
+
+
+class PublisherNames:
+    """The full names of the nodes behind publisher gids on a topic, from the graph (looked up again,
+    at most every POLL_SECONDS, when a gid is not known yet)."""
+
+    def __init__(self, graph) -> None:
+        self._graph = graph
+        self._names: dict[tuple[str, str], str] = {}
+        self._looked: dict[str, float] = {}
+
+    def name(self, topic: str, gid: str) -> str | None:
+        if (topic, gid) not in self._names and time.monotonic() - self._looked.get(topic, 0.0) >= POLL_SECONDS:
+            self._looked[topic] = time.monotonic()
+            for info in self._graph.node.get_publishers_info_by_topic(topic):
+                if info.node_name != "_NODE_NAME_UNKNOWN_":
+                    self._names[topic, gid_text(info.endpoint_gid)] = full_name(info.node_namespace, info.node_name)
+        return self._names.get((topic, gid))

@@ -24,6 +24,7 @@ from rclpy.signals import SignalHandlerOptions
 
 from roc.errors import RocError
 from roc.ros.client import DEFAULT_SPIN_TIME
+from roc.ros.gid_take import gid_text
 
 # Without a daemon, discovery lasts one Fast DDS announcement period and a margin (3.5 s: measured on
 # localhost, processes keep appearing up to 3 s after a fresh participant starts, with gaps of almost
@@ -57,7 +58,7 @@ def _endpoint(info) -> dict[str, Any]:
         "topic_type": info.topic_type,
         "topic_type_hash": str(info.topic_type_hash),
         "endpoint_type": info.endpoint_type.name,
-        "gid": ".".join(format(x, "02x") for x in info.endpoint_gid),
+        "gid": gid_text(info.endpoint_gid),
         "qos": {
             "reliability": qos.reliability.name,
             "history": qos.history.name,
