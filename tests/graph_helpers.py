@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import json
 import os
+import queue
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 from build_helpers import BIN, ros_domain_id, stop_process
@@ -52,6 +54,25 @@ def start_nodes(specs: list, env: dict[str, str]) -> list[subprocess.Popen]:
     for process in processes:
         assert process.stdout.readline().strip() == "ready"
     return processes
+
+
+def read_line(process: subprocess.Popen, timeout: float = 20.0) -> str | None:
+    """The next line of a process's stdout ("" once it has ended), or None when none came within
+    ``timeout`` seconds: a test that waits for output fails instead of hanging. Once used on a process,
+    read its stdout only through this."""
+    lines = getattr(process, "_roc_lines", None)
+    if lines is None:
+        lines = process._roc_lines = queue.SimpleQueue()
+
+        def pump() -> None:
+            for line in process.stdout:
+                lines.put(line)
+            lines.put("")
+        threading.Thread(target=pump, daemon=True).start()
+    try:
+        return lines.get(timeout=max(0.01, timeout))
+    except queue.Empty:
+        return None
 
 
 def stop_all(processes: list[subprocess.Popen]) -> None:

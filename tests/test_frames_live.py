@@ -5,20 +5,17 @@ yaw 90 degrees), base_link->laser (static), and a second tree camera->lens."""
 from __future__ import annotations
 
 import json
-import contextlib
 import os
-import queue
 import shutil
 import signal
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
 import pytest
 from build_helpers import BIN, REPO, roc, stop_process
-from graph_helpers import graph_env, stop_daemon
+from graph_helpers import graph_env, read_line, stop_daemon
 
 pytestmark = pytest.mark.slow
 TF_NODE = Path(__file__).resolve().parent / "tf_node.py"
@@ -46,7 +43,7 @@ def tree(sourced):
     processes = [subprocess.Popen([sys.executable, str(TF_NODE), mode], env=sourced, stdout=subprocess.PIPE,
                                   stderr=subprocess.DEVNULL, text=True) for mode in ("publish", "camera")]
     try:
-        assert [process.stdout.readline().strip() for process in processes] == ["ready", "ready"]
+        assert [read_line(process, 60) for process in processes] == ["ready\n", "ready\n"]
         yield sourced
     finally:
         for process in processes:
@@ -122,7 +119,7 @@ def test_a_frame_sent_by_two_nodes_names_both(tree) -> None:
                             "--duration", "20"], env=tree, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     both, deadline = sorted([f"/_roc_{pub.pid}", "/tf_camera"]), time.monotonic() + 30
     try:
-        assert pub.stdout.readline().startswith("publishing camera -> lens on /tf at 10 Hz")
+        assert (read_line(pub) or "").startswith("publishing camera -> lens on /tf at 10 Hz")
         while True:  # (until the daemon has discovered the fresh publisher)
             rows = json.loads(frame("list", "--format", "json", "--duration", "2", env=tree).stdout)
             lens = {row["frame"]: row["publishers"] for row in rows}["lens"]
@@ -139,14 +136,13 @@ def test_pub_reaches_a_real_subscriber_and_ctrl_c_stops_it(sourced) -> None:
     pub = subprocess.Popen([str(BIN / "roc"), "frame", "pub", "world", "robot", "--x", "2.5"], env=sourced,
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        assert listener.stdout.readline().strip() == "ready"
-        assert pub.stdout.readline().startswith("publishing world -> robot on /tf_static")
-        lines: queue.SimpleQueue = queue.SimpleQueue()
-        threading.Thread(target=lambda: [lines.put(line) for line in listener.stdout], daemon=True).start()
+        assert read_line(listener, 60) == "ready\n"
+        assert (read_line(pub) or "").startswith("publishing world -> robot on /tf_static")
         heard, deadline = [], time.monotonic() + 15  # (the tree's transforms too, while it is published)
         while {"parent": "world", "child": "robot", "x": 2.5} not in heard and time.monotonic() < deadline:
-            with contextlib.suppress(queue.Empty):
-                heard.append(json.loads(lines.get(timeout=0.5)))
+            line = read_line(listener, 0.5)
+            if line:
+                heard.append(json.loads(line))
         assert {"parent": "world", "child": "robot", "x": 2.5} in heard
         pub.send_signal(signal.SIGINT)
         assert pub.wait(timeout=10) == 130

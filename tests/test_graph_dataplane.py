@@ -10,7 +10,7 @@ import time
 
 import pytest
 from build_helpers import BIN, stop_process
-from graph_helpers import graph_env, install_oracle, roc, ros2, start_nodes, stop_all, stop_daemon
+from graph_helpers import graph_env, install_oracle, read_line, roc, ros2, start_nodes, stop_all, stop_daemon
 
 pytestmark = pytest.mark.slow
 
@@ -88,7 +88,7 @@ def _received(listener: subprocess.Popen, count: int, timeout: float = 10.0) -> 
     """The next ``count`` messages the listener printed."""
     lines, deadline = [], time.monotonic() + timeout
     while len(lines) < count and time.monotonic() < deadline:
-        line = listener.stdout.readline()
+        line = read_line(listener, deadline - time.monotonic()) or ""
         if line.startswith("{"):  # (the action server in the same process prints "canceled")
             lines.append(json.loads(line)["message"])
     return lines
@@ -134,7 +134,7 @@ def test_ctrl_c_leaves_no_subscription_in_the_daemon(graph) -> None:
     echo = subprocess.Popen([str(BIN / "roc"), "topic", "echo", "/chatter"], env=env, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     try:
-        assert echo.stdout.readline() == "data: hello\n"
+        assert read_line(echo) == "data: hello\n"
         assert subscribers() == before + 1  # the echo's subscription lives in the daemon
         echo.send_signal(signal.SIGINT)
         assert echo.wait(timeout=10) == 130
@@ -261,9 +261,14 @@ def test_ctrl_c_cancels_the_goal_and_says_so(graph) -> None:
     try:
         lines = []
         while not any(line.startswith("Goal accepted") for line in lines):
-            lines.append(goal.stdout.readline())
+            lines.append(read_line(goal, 30))
+            assert lines[-1], f"send_goal said no 'Goal accepted': {lines}"
         goal.send_signal(signal.SIGINT)
-        out, _ = goal.communicate(timeout=20)
+        rest = []
+        while (line := read_line(goal, 20)) and len(rest) < 1000:
+            rest.append(line)
+        out = "".join(rest)
+        goal.wait(timeout=20)
     finally:
         stop_process(goal)
     assert goal.returncode == 130
@@ -271,7 +276,7 @@ def test_ctrl_c_cancels_the_goal_and_says_so(graph) -> None:
     deadline = time.monotonic() + 10
     printed = ""
     while "canceled" not in printed and time.monotonic() < deadline:  # what the server says (one process with MOTOR)
-        printed = listener.stdout.readline()
+        printed = read_line(listener, deadline - time.monotonic()) or ""
     assert "canceled" in printed
 
 
