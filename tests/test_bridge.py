@@ -14,7 +14,7 @@ import pytest
 from build_helpers import BIN, ros_domain_id, stop_process
 from graph_helpers import graph_env, roc, start_nodes, stop_all
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("busy_or_timing")]  # see scripts/test.sh
 
 TALKER = {"name": "talker", "publishers": [
     {"topic": "chatter", "type": "std_msgs/msg/String", "values": {"data": "hi"}, "rate_hz": 20},

@@ -22,6 +22,8 @@ from websockets.sync.client import connect
 from roc.ros.foxglove_server import SEPARATOR, _Session, schema_text
 from roc.ros.interfaces import definition_path
 
+pytestmark = pytest.mark.xdist_group("busy_or_timing")  # see scripts/test.sh
+
 SUBPROTOCOLS = ["foxglove.sdk.v1", "foxglove.websocket.v1"]
 TALKER = {"name": "talker", "publishers": [
     {"topic": "chatter", "type": "std_msgs/msg/String", "values": {"data": "hi"}, "rate_hz": 20},

@@ -16,6 +16,8 @@ from build_helpers import ros_domain_id
 from graph_helpers import graph_env, roc, start_nodes, stop_all
 from test_bridge import _bridge, _line, _stop, _talker_and_listener
 
+pytestmark = pytest.mark.xdist_group("busy_or_timing")  # see scripts/test.sh
+
 BASIC_TYPES = {"bool_value": True, "char_value": 65, "float32_value": 1.5, "float64_value": -2.25, "int8_value": -8,
                "uint8_value": 200, "int16_value": -1600, "uint16_value": 60000, "int32_value": -320000,
                "uint32_value": 4000000000, "int64_value": -(2 ** 40), "uint64_value": 2 ** 63}

@@ -113,6 +113,7 @@ def test_bad_request_gets_an_error_line(talker):
     assert second["final"] and "error" in second
 
 
+@pytest.mark.xdist_group("busy_or_timing")
 def test_no_daemon_is_complete(tmp_path):
     """Five processes, ten daemon-less runs: every node every time (ros2 misses some in most runs)."""
     env = graph_env(40, tmp_path)
