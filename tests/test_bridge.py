@@ -200,11 +200,12 @@ def test_a_service_and_an_action_are_served_in_the_other_domain(tmp_path: Path) 
         assert (f"bridging service /echo_types [test_msgs/srv/BasicTypes] domain {a['ROS_DOMAIN_ID']} -> "
                 f"{b['ROS_DOMAIN_ID']}\n") in announced
         called = roc("service", "call", "/echo_types", "test_msgs/srv/BasicTypes",
-                     "{int32_value: 7, string_value: across}", "--format", "json", env=b)
+                     "{int32_value: 7, string_value: across}", "--format", "json", "--no-daemon", env=b)
         assert called.returncode == 0, called.stderr
         response = json.loads(called.stdout.splitlines()[-1])
         assert (response["response"]["int32_value"], response["response"]["string_value"]) == (7, "across")
-        goal = roc("action", "send_goal", "/fibonacci", "test_msgs/action/Fibonacci", "{order: 5}", env=b)
+        goal = roc("action", "send_goal", "/fibonacci", "test_msgs/action/Fibonacci", "{order: 5}", "--no-daemon",
+                   env=b)
         assert goal.returncode == 0, goal.stderr
         assert "sequence:\n- 0\n- 1\n- 1\n- 2\n- 3\n- 5\n" in goal.stdout
         assert "Goal finished with status: SUCCEEDED" in goal.stdout

@@ -77,7 +77,7 @@ def test_frame_verbs_work_in_the_sourced_example(example):
     env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin", "ROS_DOMAIN_ID": ros_domain_id(60),
            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST", "RMW_IMPLEMENTATION": "rmw_fastrtps_cpp"}
     source = "set -eu; source install/setup.bash; exec "
-    pub = subprocess.Popen(["bash", "-c", source + "roc frame pub map odom --x 1 --yaw 90 --degrees"], cwd=example,
+    pub = subprocess.Popen(["bash", "-c", source + "roc frame pub map odom --x 1 --yaw 90 --degrees --no-daemon"], cwd=example,
                            env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         echo = subprocess.run(["bash", "-c", source + "roc frame echo map odom --once --no-daemon --timeout 30"],
