@@ -133,3 +133,17 @@ def stop_daemon(env: dict[str, str]) -> None:
             pass
     if (ORACLE_VENV / "bin" / "ros2").exists():  # the oracle may have started its daemon in this domain
         ros2("daemon", "stop", env=env)
+
+
+def assert_call_and_goal_work(env: dict[str, str]) -> None:
+    """A test_msgs/srv/BasicTypes call to /echo_types (graph_node's ``echo`` server) and a Fibonacci goal
+    to /fibonacci, both daemon-less in ``env``, get the server's answers (through a bridge, in its tests)."""
+    called = roc("service", "call", "/echo_types", "test_msgs/srv/BasicTypes",
+                 "{int32_value: 7, string_value: across}", "--format", "json", "--no-daemon", env=env)
+    assert called.returncode == 0, called.stderr
+    response = json.loads(called.stdout.splitlines()[-1])
+    assert (response["response"]["int32_value"], response["response"]["string_value"]) == (7, "across")
+    goal = roc("action", "send_goal", "/fibonacci", "test_msgs/action/Fibonacci", "{order: 5}", "--no-daemon", env=env)
+    assert goal.returncode == 0, goal.stderr
+    assert "sequence:\n- 0\n- 1\n- 1\n- 2\n- 3\n- 5\n" in goal.stdout
+    assert "Goal finished with status: SUCCEEDED" in goal.stdout

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 from build_helpers import BIN, ros_domain_id, stop_process
-from graph_helpers import graph_env, roc, start_nodes, stop_all
+from graph_helpers import assert_call_and_goal_work, graph_env, roc, start_nodes, stop_all
 
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("busy_or_timing")]  # see scripts/test.sh
 
@@ -199,16 +199,7 @@ def test_a_service_and_an_action_are_served_in_the_other_domain(tmp_path: Path) 
         announced = _bridging_lines(bridge, 6)
         assert (f"bridging service /echo_types [test_msgs/srv/BasicTypes] domain {a['ROS_DOMAIN_ID']} -> "
                 f"{b['ROS_DOMAIN_ID']}\n") in announced
-        called = roc("service", "call", "/echo_types", "test_msgs/srv/BasicTypes",
-                     "{int32_value: 7, string_value: across}", "--format", "json", "--no-daemon", env=b)
-        assert called.returncode == 0, called.stderr
-        response = json.loads(called.stdout.splitlines()[-1])
-        assert (response["response"]["int32_value"], response["response"]["string_value"]) == (7, "across")
-        goal = roc("action", "send_goal", "/fibonacci", "test_msgs/action/Fibonacci", "{order: 5}", "--no-daemon",
-                   env=b)
-        assert goal.returncode == 0, goal.stderr
-        assert "sequence:\n- 0\n- 1\n- 1\n- 2\n- 3\n- 5\n" in goal.stdout
-        assert "Goal finished with status: SUCCEEDED" in goal.stdout
+        assert_call_and_goal_work(b)
     finally:
         assert _stop(bridge) == 130
         stop_all(server)

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 from build_helpers import ros_domain_id
-from graph_helpers import graph_env, roc, start_nodes, stop_all
+from graph_helpers import assert_call_and_goal_work, graph_env, roc, start_nodes, stop_all
 from test_bridge import _bridge, _line, _stop, _talker_and_listener
 
 pytestmark = pytest.mark.xdist_group("busy_or_timing")  # see scripts/test.sh
@@ -101,16 +101,7 @@ def test_topics_arrive_intact_with_their_names_types_and_qos_and_a_service_and_a
                   for part in ("send_goal", "cancel_goal", "get_result", "feedback", "status")}
         came_in = _events_until(links[1], _carried("in", {f"/{topic}" for topic, *_ in PUBLISHED} | {"/echo_types"}
                                                    | action))
-        called = roc("service", "call", "/echo_types", "test_msgs/srv/BasicTypes",
-                     "{int32_value: 7, string_value: across}", "--format", "json", "--no-daemon", env=b)
-        assert called.returncode == 0, called.stderr
-        response = json.loads(called.stdout.splitlines()[-1])
-        assert (response["response"]["int32_value"], response["response"]["string_value"]) == (7, "across")
-        goal = roc("action", "send_goal", "/fibonacci", "test_msgs/action/Fibonacci", "{order: 5}", "--no-daemon",
-                   env=b)
-        assert goal.returncode == 0, goal.stderr
-        assert "sequence:\n- 0\n- 1\n- 1\n- 2\n- 3\n- 5\n" in goal.stdout
-        assert "Goal finished with status: SUCCEEDED" in goal.stdout
+        assert_call_and_goal_work(b)
         # listeners that start later still: the latched message is kept on both sides
         processes += start_nodes([[_listener("a")]], a) + start_nodes([[_listener("b")]], b)
         direct, bridged = _first_messages(processes[-2]), _first_messages(processes[-1])
