@@ -66,6 +66,22 @@ class Route:
         return replace(self, from_domain=self.to_domain, to_domain=self.from_domain)
 
 
+class TopicFilter:
+    """``--include``/``--exclude``: a name passes when it matches one of ``include`` (any name when
+    empty) and none of ``exclude`` (regular expressions, searched)."""
+
+    def __init__(self, include: list[str] = (), exclude: list[str] = ()) -> None:
+        try:
+            self.include = [re.compile(pattern) for pattern in include]
+            self.exclude = [re.compile(pattern) for pattern in exclude]
+        except re.error as error:
+            raise UsageError(f"--include/--exclude: invalid regular expression '{error.pattern}': {error}") from None
+
+    def __call__(self, name: str) -> bool:
+        return (not any(p.search(name) for p in self.exclude)
+                and (not self.include or any(p.search(name) for p in self.include)))
+
+
 def action_routes(action: Route) -> list[Route]:
     """An action is three services and two topics (``NAME/_action/...``); bridging those bridges it."""
     def part(suffix: str, kind: str) -> Route:
@@ -108,6 +124,12 @@ def loop_guard(routes: list[Route], environment: dict[str, str] = os.environ) ->
                              f"{IGNORE_LOCAL_PROPERTY}=true in this Fast DDS profile (see {IGNORE_LOCAL_PROFILE})")
 
 
+def receive_profile(offered: QoSProfile) -> QoSProfile:
+    """A bridge's subscription for what is ``offered``: the same reliability and durability, a deep queue."""
+    return QoSProfile(depth=max(offered.depth, RECEIVE_DEPTH), history=offered.history,
+                      reliability=offered.reliability, durability=offered.durability)
+
+
 def qos_name(profile: QoSProfile) -> tuple[str, str]:
     return ("reliable" if profile.reliability == ReliabilityPolicy.RELIABLE else "best_effort",
             "transient_local" if profile.durability == DurabilityPolicy.TRANSIENT_LOCAL else "volatile")
@@ -129,8 +151,7 @@ class DomainBridge:
         source domain whose name matches one of ``include`` (all when empty) and none of ``exclude``.
         Sets up the ``loop_guard``: make it the process's first participant."""
         self.routes = [part for r in routes for part in (action_routes(r) if r.kind == "action" else [r])]
-        self.include = [re.compile(pattern) for pattern in include]
-        self.exclude = [re.compile(pattern) for pattern in exclude]
+        self.wanted = TopicFilter(include, exclude)
         self.everything = everything
         loop_guard(self.routes + ([Route("*", *everything)] if everything else []))
         domains = {d for r in self.routes for d in (r.from_domain, r.to_domain)} | set(everything or ())
@@ -149,11 +170,8 @@ class DomainBridge:
         if self.everything is not None:
             source, target = self.everything
             named = {r.name for r in routes if r.from_domain == source and r.kind == "topic"}
-            for name, _types in self.graphs[source].node.get_topic_names_and_types():
-                if name in named or any(p.search(name) for p in self.exclude):
-                    continue
-                if not self.include or any(p.search(name) for p in self.include):
-                    routes.append(Route(name, source, target))
+            routes += [Route(name, source, target) for name, _types in self.graphs[source].node.get_topic_names_and_types()
+                       if name not in named and self.wanted(name)]
         return routes
 
     def _source_type(self, route: Route) -> str | None:
@@ -171,10 +189,7 @@ class DomainBridge:
             return None
         cls = message_class(type_name)
         outgoing = qos_profile({"profile": "default", **route.qos}, publishers)
-        outgoing = QoSProfile(depth=outgoing.depth, history=outgoing.history, reliability=outgoing.reliability,
-                              durability=outgoing.durability)
-        incoming = QoSProfile(depth=max(outgoing.depth, RECEIVE_DEPTH), history=outgoing.history,
-                              reliability=outgoing.reliability, durability=outgoing.durability)
+        incoming = receive_profile(outgoing)
         publisher = self.graphs[route.to_domain].node.create_publisher(cls, route.target, outgoing)
         link = _TopicLink(route, type_name, None, publisher)
 

@@ -114,10 +114,9 @@ class Daemon:
                 raise RocError("a request needs a 'method'")
             else:
                 params = request.get("params") or {}
-                # tf listening that waits for what it needs (frame echo) can start before the discovery
-                # period: its subscriptions match publishers as they are found, as tf2's listener does
-                early = method == "frames" and params.get("early")
-                if not (self.created if early else self.ready).wait(30):
+                # a stream that waits for what it needs (frame echo's tf) may ask to start before the
+                # discovery period: its subscriptions match publishers as they are found
+                if not (self.created if params.get("early") else self.ready).wait(30):
                     raise RocError("the daemon's graph participant did not start")
                 from roc.ros.streams import STREAMS
 

@@ -46,8 +46,8 @@ from websockets.asyncio.client import connect
 from websockets.asyncio.server import serve
 from websockets.exceptions import ConnectionClosed
 
-from roc.errors import RocError, UsageError
-from roc.ros.bridge import RECEIVE_DEPTH
+from roc.errors import RocError
+from roc.ros.bridge import RECEIVE_DEPTH, TopicFilter
 from roc.ros.dataplane import qos_profile, serialize
 from roc.ros.graph import Graph
 from roc.ros.interfaces import definition_path
@@ -245,11 +245,7 @@ class FoxgloveServer:
 
     def __init__(self, host: str = "127.0.0.1", port: int = 8765, domain: int | None = None,
                  include: list[str] = (), exclude: list[str] = ()) -> None:
-        try:
-            self.include = [re.compile(pattern) for pattern in include]
-            self.exclude = [re.compile(pattern) for pattern in exclude]
-        except re.error as error:
-            raise UsageError(f"--include/--exclude: invalid regular expression '{error.pattern}': {error}") from None
+        self._wanted = TopicFilter(include, exclude)
         self.host, self.events = host, queue.Queue()
         self.topics: dict[str, _Topic] = {}
         self.skipped: set[str] = set()
@@ -280,10 +276,6 @@ class FoxgloveServer:
         self.graph.close()
 
     # -- ROS topics to channels -----------------------------------------------------------------
-    def _wanted(self, name: str) -> bool:
-        return (not any(p.search(name) for p in self.exclude)
-                and (not self.include or any(p.search(name) for p in self.include)))
-
     def _published(self, name: str) -> bool:
         return any(p.node_name != SERVER_NODE for p in self.graph.node.get_publishers_info_by_topic(name))
 

@@ -42,11 +42,12 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from roc.errors import RocError, UsageError
 from roc.ros.bridge import (
     BRIDGE_NODE,
-    RECEIVE_DEPTH,
     Route,
+    TopicFilter,
     action_routes,
     loop_guard,
     qos_name,
+    receive_profile,
 )
 from roc.ros.dataplane import qos_profile
 from roc.ros.graph import Graph
@@ -149,8 +150,7 @@ class ZenohLink:
         topics = [*topics, *(part.name for part in parts if part.kind == "topic")]
         self.domain = domain
         self.topics = set(topics)
-        self.include = [re.compile(pattern) for pattern in include]
-        self.exclude = [re.compile(pattern) for pattern in exclude]
+        self.wanted = TopicFilter(include, exclude)
         self.everything = everything
         self.events: queue.SimpleQueue[dict[str, Any]] = queue.SimpleQueue()
         self.outgoing: dict[str, _Topic] = {}
@@ -195,8 +195,7 @@ class ZenohLink:
     def selected(self, topic: str) -> bool:
         if topic in self.topics:
             return True
-        return (self.everything and not any(p.search(topic) for p in self.exclude)
-                and (not self.include or any(p.search(topic) for p in self.include)))
+        return self.everything and self.wanted(topic)
 
     # -- ROS to Zenoh -------------------------------------------------------------------------------
     def _scan(self) -> None:
@@ -224,8 +223,7 @@ class ZenohLink:
 
     def _carry_out(self, name: str, type_name: str, publishers: list) -> None:
         offered = qos_profile({"profile": "default"}, publishers)
-        incoming = QoSProfile(depth=max(offered.depth, RECEIVE_DEPTH), history=offered.history,
-                              reliability=offered.reliability, durability=offered.durability)
+        incoming = receive_profile(offered)
         reliability, durability = qos_name(incoming)
         reliable = reliability == "reliable"
         options = {"congestion_control": zenoh.CongestionControl.BLOCK if reliable else zenoh.CongestionControl.DROP,
