@@ -15,9 +15,6 @@ from roc.ros.messages import echo_text, get_field, value_to_data
 from roc.ros.types import message_class
 
 DEFAULT_TRUNCATE_LENGTH = 128
-# ros2 subscribes with the sensor_data depth, 5: a burst larger than that is lost while the terminal
-# catches up. roc keeps the last 1000 (--qos-depth sets another).
-DEFAULT_DEPTH = 1000
 INFO_FIELDS = ("source_timestamp", "received_timestamp", "publication_sequence_number", "reception_sequence_number")
 
 
@@ -72,10 +69,7 @@ def run(args: argparse.Namespace) -> int:
     accept = message_filter(args.filter_expr)
     limit = None if args.full_length else args.truncate_length
     options = {"no_arr": args.no_arr, "no_str": args.no_str, "truncate_length": limit}
-    qos = qos_options(args)
-    if qos["depth"] is None and args.qos_history != "keep_all":
-        qos["depth"] = DEFAULT_DEPTH
-    params = {"topic": args.topic_name, "type": args.message_type, "qos": qos,
+    params = {"topic": args.topic_name, "type": args.message_type, "qos": qos_options(args),
               "wait": publisher_wait(args),
               "timeout": args.timeout}
     lost_total = 0

@@ -47,8 +47,8 @@ from websockets.asyncio.server import serve
 from websockets.exceptions import ConnectionClosed
 
 from roc.errors import RocError
-from roc.ros.bridge import RECEIVE_DEPTH, TopicFilter
-from roc.ros.dataplane import qos_profile, serialize
+from roc.ros.bridge import TopicFilter
+from roc.ros.dataplane import serialize, subscription_profile
 from roc.ros.graph import Graph
 from roc.ros.interfaces import definition_path
 from roc.ros.messages import fill_message
@@ -318,8 +318,7 @@ class FoxgloveServer:
             if joins and topic.subscription is not None and topic.subscription.qos_profile.durability == LATCHED:
                 self._unsubscribe_ros(topic)  # a new subscription gets the kept messages for the new client too
             if topic.subscription is None:
-                qos = qos_profile({"profile": "default", "depth": RECEIVE_DEPTH},
-                                  self.graph.node.get_publishers_info_by_topic(name))
+                qos = subscription_profile({"profile": "default"}, self.graph.node.get_publishers_info_by_topic(name))
                 log = topic.channel.log
 
                 def forward(data: bytes, topic: _Topic = topic) -> None:

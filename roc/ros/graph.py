@@ -24,7 +24,7 @@ from rclpy.signals import SignalHandlerOptions
 
 from roc.errors import RocError
 from roc.ros.client import DEFAULT_SPIN_TIME
-from roc.ros.gid_take import gid_text
+from roc.ros.raw_subscription import gid_text
 
 # Without a daemon, discovery lasts one Fast DDS announcement period and a margin (3.5 s: measured on
 # localhost, processes keep appearing up to 3 s after a fresh participant starts, with gaps of almost

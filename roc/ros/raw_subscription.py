@@ -1,0 +1,210 @@
+"""Raw subscriptions taken on a thread of their own, outside any executor, with the whole message info.
+
+Two reasons. rclpy 7 (Jazzy) leaves the publisher's gid out of the message info it gives Python,
+although rmw fills it in; tf needs it to name the node behind each frame, and echo to count losses per
+publisher. And rclpy's Python executor costs so much per message that a 5 kHz topic overflows the
+subscription's history on a busy machine, while its C++ EventsExecutor never calls a callback that
+takes message info. So a RawSubscription is taken with rcl's ``rcl_take_serialized_message`` through
+ctypes, on the rcl handle rclpy made for it, and a Receiver waits for messages in rcl (without
+Python's lock) and takes each as it arrives, queueing it for whoever reads the batches.
+"""
+
+from __future__ import annotations
+
+import collections
+import ctypes
+import functools
+import threading
+from collections.abc import Hashable
+from typing import Any
+
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+from rclpy.qos import QoSProfile
+from rclpy.type_support import check_is_valid_msg_type
+
+from roc.errors import RocError
+
+RCL_RET_OK = 0
+RCL_RET_SUBSCRIPTION_TAKE_FAILED = 401  # nothing to take
+GID_SIZE = 16  # RMW_GID_STORAGE_SIZE of Jazzy's rmw
+SEQUENCE_UNSUPPORTED = 2**64 - 1  # RMW_MESSAGE_INFO_SEQUENCE_NUMBER_UNSUPPORTED
+MAX_TAKE = 1000  # messages taken from one subscription before the others get their turn
+MAX_QUEUED_BYTES = 64 * 2**20  # taken messages a Receiver holds for a slow reader
+WAIT_NANOSECONDS = 1_000_000_000  # a Receiver's longest wait in rcl (close wakes it at once)
+
+
+class _Allocator(ctypes.Structure):  # rcutils_allocator_t
+    _fields_ = [("allocate", ctypes.c_void_p), ("deallocate", ctypes.c_void_p), ("reallocate", ctypes.c_void_p),
+                ("zero_allocate", ctypes.c_void_p), ("state", ctypes.c_void_p)]
+
+
+class _Bytes(ctypes.Structure):  # rcutils_uint8_array_t (rmw_serialized_message_t)
+    _fields_ = [("buffer", ctypes.POINTER(ctypes.c_uint8)), ("buffer_length", ctypes.c_size_t),
+                ("buffer_capacity", ctypes.c_size_t), ("allocator", _Allocator)]
+
+
+class _Gid(ctypes.Structure):  # rmw_gid_t
+    _fields_ = [("implementation_identifier", ctypes.c_char_p), ("data", ctypes.c_uint8 * GID_SIZE)]
+
+
+class _Info(ctypes.Structure):  # rmw_message_info_t
+    _fields_ = [("source_timestamp", ctypes.c_int64), ("received_timestamp", ctypes.c_int64),
+                ("publication_sequence_number", ctypes.c_uint64), ("reception_sequence_number", ctypes.c_uint64),
+                ("publisher_gid", _Gid), ("from_intra_process", ctypes.c_bool)]
+
+
+@functools.cache
+def _libraries() -> tuple[ctypes.CDLL, ctypes.CDLL]:
+    """librcl and librcutils as rclpy loaded them (dlopen finds a loaded library by its name). As
+    PyDLLs, whose calls keep Python's lock: a take is a copy, and releasing the lock around each one
+    lets any busy thread of the process hold it for a switch interval (5 ms) per message taken."""
+    rcl, rcutils = ctypes.PyDLL("librcl.so"), ctypes.PyDLL("librcutils.so")
+    rcutils.rcutils_get_default_allocator.restype = _Allocator
+    rcutils.rcutils_uint8_array_init.argtypes = [ctypes.POINTER(_Bytes), ctypes.c_size_t, ctypes.POINTER(_Allocator)]
+    rcutils.rcutils_uint8_array_fini.argtypes = [ctypes.POINTER(_Bytes)]
+    rcl.rcl_take_serialized_message.argtypes = [ctypes.c_void_p, ctypes.POINTER(_Bytes), ctypes.POINTER(_Info),
+                                                ctypes.c_void_p]
+    rcl.rcl_take_serialized_message.restype = ctypes.c_int32
+    return rcl, rcutils
+
+
+def gid_text(gid) -> str:
+    """A gid as roc writes it everywhere (graph endpoint infos too): hex bytes joined by dots."""
+    return ".".join(format(x, "02x") for x in gid)
+
+
+@functools.lru_cache(maxsize=1024)
+def _known_gid_text(gid: bytes) -> str:
+    """gid_text, computed once per publisher rather than per message."""
+    return gid_text(gid)
+
+
+def _info(info: _Info) -> dict[str, Any]:
+    """The message info as rclpy names it, plus ``gid`` (the publisher's, as ``gid_text``); an
+    unsupported sequence number is None."""
+    return {"source_timestamp": info.source_timestamp, "received_timestamp": info.received_timestamp,
+            "publication_sequence_number": None if info.publication_sequence_number == SEQUENCE_UNSUPPORTED
+            else info.publication_sequence_number,
+            "reception_sequence_number": None if info.reception_sequence_number == SEQUENCE_UNSUPPORTED
+            else info.reception_sequence_number,
+            "gid": _known_gid_text(bytes(info.publisher_gid.data))}
+
+
+class RawSubscription:
+    """A raw subscription on ``node``, read by ``take()``: [(CDR bytes, info)] (info: see ``_info``)."""
+
+    def __init__(self, node, msg_type: type, topic: str, qos: QoSProfile) -> None:
+        check_is_valid_msg_type(msg_type)
+        self._rcl, self._rcutils = _libraries()
+        with node.handle:
+            self._handle = _rclpy.Subscription(node.handle, msg_type, topic, qos.get_c_qos_profile())
+        self._buffer = _Bytes()
+        allocator = self._rcutils.rcutils_get_default_allocator()
+        if self._rcutils.rcutils_uint8_array_init(ctypes.byref(self._buffer), 0, ctypes.byref(allocator)) != RCL_RET_OK:
+            self._handle.destroy_when_not_in_use()
+            raise RocError("cannot allocate a buffer for serialized messages")
+
+    @property
+    def handle(self):
+        return self._handle
+
+    def take(self, most: int) -> list[tuple[bytes, dict[str, Any]]]:
+        """Up to ``most`` messages waiting, oldest first."""
+        taken = []
+        while len(taken) < most:
+            info = _Info()
+            result = self._rcl.rcl_take_serialized_message(self._handle.pointer, ctypes.byref(self._buffer),
+                                                           ctypes.byref(info), None)
+            if result == RCL_RET_SUBSCRIPTION_TAKE_FAILED:
+                break
+            if result != RCL_RET_OK:
+                raise RocError(f"rcl_take_serialized_message failed ({result})")
+            taken.append((ctypes.string_at(self._buffer.buffer, self._buffer.buffer_length), _info(info)))
+        return taken
+
+    def destroy(self) -> None:
+        self._handle.destroy_when_not_in_use()
+        self._rcutils.rcutils_uint8_array_fini(ctypes.byref(self._buffer))
+
+
+class Receiver:
+    """Raw subscriptions on ``node`` (``subscribe``), whose messages a thread of its own takes as soon
+    as they arrive, so that a slow reader of ``batch`` does not make a subscription's history
+    overflow. Taken messages wait in memory up to MAX_QUEUED_BYTES; past that the thread stops
+    taking, the histories drop the oldest and the publishers' sequence numbers show the loss.
+    ``close`` stops the thread and destroys the subscriptions."""
+
+    def __init__(self, node) -> None:
+        self._node = node
+        self._subscriptions: dict[Hashable, RawSubscription] = {}
+        self._queued: collections.deque = collections.deque()
+        self._queued_bytes = 0
+        self._changed = threading.Condition()
+        self._stopping = False
+        self._failure: Exception | None = None
+        self._wake = _rclpy.GuardCondition(node.context.handle)
+        self._thread = threading.Thread(target=self._take_all, name="roc-receiver", daemon=True)
+        self._thread.start()
+
+    def subscribe(self, key: Hashable, msg_type: type, topic: str, qos: QoSProfile) -> None:
+        """Receive ``topic``'s messages as ``key``'s."""
+        subscription = RawSubscription(self._node, msg_type, topic, qos)
+        with self._changed:
+            self._subscriptions[key] = subscription
+        self._wake.trigger_guard_condition()
+
+    def _take_all(self) -> None:
+        wait_set, waited = None, {}
+        try:
+            while not self._stopping:
+                with self._changed:
+                    subscriptions = dict(self._subscriptions)
+                if wait_set is None or len(subscriptions) != len(waited):
+                    if wait_set is not None:
+                        wait_set.destroy_when_not_in_use()
+                    wait_set = _rclpy.WaitSet(len(subscriptions), 1, 0, 0, 0, 0, self._node.context.handle)
+                waited = subscriptions
+                wait_set.clear_entities()
+                for subscription in subscriptions.values():
+                    wait_set.add_subscription(subscription.handle)
+                wait_set.add_guard_condition(self._wake)
+                wait_set.wait(WAIT_NANOSECONDS)  # Python's lock is free meanwhile
+                for key, subscription in subscriptions.items():
+                    self._queue(key, subscription.take(MAX_TAKE))
+        except Exception as error:  # noqa: BLE001 - handed to the reader, who reports it
+            with self._changed:
+                self._failure = error
+                self._changed.notify_all()
+        finally:
+            if wait_set is not None:
+                wait_set.destroy_when_not_in_use()
+
+    def _queue(self, key: Hashable, taken: list[tuple[bytes, dict[str, Any]]]) -> None:
+        with self._changed:
+            while self._queued_bytes > MAX_QUEUED_BYTES and not self._stopping:
+                self._changed.wait()
+            self._queued.extend((key, data, info) for data, info in taken)
+            self._queued_bytes += sum(len(data) for data, _ in taken)
+            self._changed.notify_all()
+
+    def batch(self, timeout: float, most: int = MAX_TAKE) -> list[tuple[Hashable, bytes, dict[str, Any]]]:
+        """Up to ``most`` taken messages, oldest first, as (key, CDR bytes, info); waits up to
+        ``timeout`` seconds for the first and is empty when none came."""
+        with self._changed:
+            self._changed.wait_for(lambda: self._queued or self._failure, timeout)
+            if self._failure is not None:
+                raise RocError(f"taking messages failed: {self._failure}")
+            batch = [self._queued.popleft() for _ in range(min(most, len(self._queued)))]
+            self._queued_bytes -= sum(len(data) for _, data, _ in batch)
+            self._changed.notify_all()
+        return batch
+
+    def close(self) -> None:
+        with self._changed:
+            self._stopping = True
+            self._changed.notify_all()
+        self._wake.trigger_guard_condition()
+        self._thread.join()
+        for subscription in self._subscriptions.values():
+            subscription.destroy()
+        self._wake.destroy_when_not_in_use()
