@@ -215,3 +215,17 @@ def test_the_loop_guard_sets_roc_s_profile_or_checks_the_user_s(tmp_path: Path) 
         loop_guard(both, {"FASTRTPS_DEFAULT_PROFILES_FILE": str(theirs)})
     with pytest.raises(UsageError, match="/x: bridging both ways needs Fast DDS"):
         loop_guard(both, {"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"})
+
+
+@pytest.mark.parametrize(("environment", "transports"), [
+    ({}, "UDPv4"),
+    ({"RMW_IMPLEMENTATION": "rmw_fastrtps_dynamic_cpp"}, "UDPv4"),
+    ({"FASTDDS_BUILTIN_TRANSPORTS": "SHM"}, "SHM"),
+    ({"FASTRTPS_DEFAULT_PROFILES_FILE": "/mine.xml"}, None),
+    ({"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"}, None),
+], ids=["fast-dds", "dynamic", "user-transports", "user-profile", "cyclone"])
+def test_roc_receives_over_udp_unless_the_user_chose(environment: dict, transports: str | None) -> None:
+    from roc.ros.graph import receive_over_udp
+
+    receive_over_udp(environment)
+    assert environment.get("FASTDDS_BUILTIN_TRANSPORTS") == transports

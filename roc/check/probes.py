@@ -120,7 +120,7 @@ def _service(expectation: Expectation, session, timeout: float, _window: float) 
         raise Failed(f"type {', '.join(types)}, expected {expected['type']}", types)
     if "request" not in expected and "response" not in expected:
         return f"served ({', '.join(types)})", types
-    from roc.ros.dataplane import decode, encode
+    from roc.ros.cdr import decode, encode
     from roc.ros.messages import fill_message, parse_values, value_to_data
     from roc.ros.types import service_class
 

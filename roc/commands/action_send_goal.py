@@ -31,7 +31,7 @@ def _indented(message) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Exit 1 when the goal is rejected or does not succeed, 130 when canceled by Ctrl+C."""
-    from roc.ros.dataplane import decode, encode
+    from roc.ros.cdr import decode, encode
 
     cls = action_class(args.action_type)
     request = fill_message(cls.Goal, parse_values(args.goal, "goal"))
@@ -98,7 +98,7 @@ def _cancel(args: argparse.Namespace, goal_id: str) -> None:
     """Cancel the goal through the action's cancel service, and say how it went."""
     from action_msgs.srv import CancelGoal
 
-    from roc.ros.dataplane import decode, encode
+    from roc.ros.cdr import decode, encode
 
     print_text("Canceling goal...\n")
     request = CancelGoal.Request()

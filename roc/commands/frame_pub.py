@@ -67,7 +67,7 @@ def _stamped(tf_message):
 
 def run(args: argparse.Namespace) -> int:
     from roc.frames.listen import require_tf2_msgs
-    from roc.ros.dataplane import encode, serialize
+    from roc.ros.cdr import encode, serialize
 
     require_tf2_msgs()
     if args.rate is not None and args.rate <= 0:

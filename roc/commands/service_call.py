@@ -25,7 +25,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     if args.rate is not None and args.rate <= 0:
         raise UsageError(f"--rate: must be above 0 Hz, got {args.rate:g}")
-    from roc.ros.dataplane import decode, encode
+    from roc.ros.cdr import decode, encode
 
     cls = service_class(args.service_type)
     request = fill_message(cls.Request, parse_values(args.values))

@@ -102,7 +102,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _message_text(event: dict, type_name: str, args: argparse.Namespace, accept, options: dict) -> str | None:
     """One message as asked; None when --filter rejects it."""
-    from roc.ros.dataplane import decode
+    from roc.ros.cdr import decode
 
     if args.raw:
         value = base64.b64decode(event["data"])

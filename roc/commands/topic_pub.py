@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"--rate: must be above 0 Hz, got {args.rate:g}")
     if args.print_every < 0 or args.times < 0:
         raise UsageError("--print and --times take a number of 0 or more")
-    from roc.ros.dataplane import encode
+    from roc.ros.cdr import encode
 
     text, source = _values_text(args)
     stamps: list = []
@@ -91,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
 def _restamp(message, stamps: list) -> bytes:
     from builtin_interfaces.msg import Time
 
-    from roc.ros.dataplane import serialize
+    from roc.ros.cdr import serialize
 
     now = time.time_ns()
     for setter in stamps:

@@ -73,7 +73,7 @@ def _filtered(args: argparse.Namespace, topic: str, accept, wait: float):
     """``batch`` events from the ``echo`` stream, with only the messages ``accept`` takes."""
     import base64
 
-    from roc.ros.dataplane import decode
+    from roc.ros.cdr import decode
 
     columns = ("sequence", "source", "received", "size", "stamp")
     batch, type_name, due = {column: [] for column in columns}, None, time.monotonic() + 1.0

@@ -40,7 +40,7 @@ class Listener:
     def listen(self, done: Callable[[], bool] = lambda: False, seconds: float | None = None) -> bool:
         """Take in transforms until ``done()`` (True) or ``seconds`` have passed (False), counted from
         the subscription (a cold daemon takes a while to start)."""
-        from roc.ros.dataplane import decode
+        from roc.ros.cdr import decode
 
         start = time.monotonic() if self._subscribed else None
         if done():

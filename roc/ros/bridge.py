@@ -29,14 +29,13 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from roc.errors import UsageError
 from roc.ros.bridge_services import ServiceLink
 from roc.ros.dataplane import RECEIVE_DEPTH, qos_profile
-from roc.ros.graph import Graph
+from roc.ros.graph import PROFILE_VARIABLES, Graph
 from roc.ros.types import message_class
 
 SCAN_SECONDS = 1.0
 BRIDGE_NODE = "_roc_bridge"
 IGNORE_LOCAL_PROFILE = Path(__file__).with_name("fastdds_ignore_local.xml")
 IGNORE_LOCAL_PROPERTY = "fastdds.ignore_local_endpoints"
-PROFILE_VARIABLES = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE")  # Fast DDS 2 (Jazzy), 3
 
 
 @dataclass(frozen=True)

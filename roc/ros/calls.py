@@ -13,7 +13,8 @@ from typing import Any
 
 from rclpy.serialization import deserialize_message
 
-from roc.ros.dataplane import HEARTBEAT_SECONDS, serialize
+from roc.ros.cdr import serialize
+from roc.ros.dataplane import HEARTBEAT_SECONDS
 from roc.ros.types import action_class, service_class
 
 

@@ -2,7 +2,7 @@
 (``publish``) on a Graph's node, each a stream of plain-data events (roc.ros.streams names them
 all). The same generators run inside the roc daemon (each event a line on the client's socket, so
 the endpoint lives in an already discovered participant) and in a daemon-less run. Messages travel as serialised CDR (base64 in JSON); the client turns them into
-message objects (``decode``), so the daemon never needs a verb's output options.
+message objects (``roc.ros.cdr.decode``), so the daemon never needs a verb's output options.
 
 A stream ends when its generator is closed: the daemon closes it when the client goes away (a
 heartbeat event at least every HEARTBEAT_SECONDS finds out), and the ``finally`` blocks destroy the
@@ -25,7 +25,6 @@ from rclpy.qos import (
     QoSProfile,
     ReliabilityPolicy,
 )
-from rclpy.serialization import deserialize_message, serialize_message
 
 from roc.errors import RocError
 from roc.ros.graph import full_name
@@ -73,23 +72,6 @@ def subscription_profile(options: dict[str, Any], publishers: list | None = None
     if options.get("depth") is None and options.get("history") != "keep_all":
         options = {**options, "depth": RECEIVE_DEPTH}
     return qos_profile(options, publishers)
-
-
-def decode(message_type: str | type, data: str) -> Any:
-    """A message object (a message type's name, or a class such as a service's Response) from base64
-    CDR, as stream events carry messages."""
-    cls = message_class(message_type) if isinstance(message_type, str) else message_type
-    return deserialize_message(base64.b64decode(data), cls)
-
-
-def serialize(message: Any) -> bytes:
-    """A message's CDR, as a raw publisher sends it."""
-    return serialize_message(message)
-
-
-def encode(message: Any) -> str:
-    """The base64 CDR of a message, for a ``publish`` request."""
-    return base64.b64encode(serialize(message)).decode()
 
 
 def publishers(graph, topic: str, wait: float) -> list:

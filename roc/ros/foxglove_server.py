@@ -48,7 +48,8 @@ from websockets.exceptions import ConnectionClosed
 
 from roc.errors import RocError
 from roc.ros.bridge import TopicFilter
-from roc.ros.dataplane import serialize, subscription_profile
+from roc.ros.cdr import serialize
+from roc.ros.dataplane import subscription_profile
 from roc.ros.graph import Graph
 from roc.ros.interfaces import definition_path
 from roc.ros.messages import fill_message
