@@ -26,30 +26,32 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                        help="with --foxglove or across Zenoh: the local ROS domain (default: ROS_DOMAIN_ID)")
 
 
+_TEXTS = {
+    "advertised": "advertised {topic} [{type}]",
+    "unadvertised": "unadvertised {topic} [{type}]",
+    "skipped": "skipped {topic} [{type}]: {reason}",
+    "client_disconnected": "client {client} disconnected",
+    "subscribed": "client {client} subscribed {topic}",
+    "unsubscribed": "client {client} unsubscribed {topic}",
+    "client_advertised": "client {client} publishes {topic} [{type}, {encoding}]",
+    "client_unadvertised": "client {client} stopped publishing {topic}",
+    "client_publish_refused": "client {client}: {topic}: refused: {reason}",
+    "client_message_refused": "client {client}: {topic}: refused: {reason}",
+}
+
+
 def _text(event: dict) -> str:
     kind = event["event"]
     if kind == "serving":
         return (f"serving ROS domain {event['domain']} to Foxglove at {event['url']} "
                 f"(subprotocols {', '.join(event['subprotocols'])})\n")
-    if kind in ("advertised", "unadvertised"):
-        return f"{kind} {event['topic']} [{event['type']}]\n"
-    if kind == "skipped":
-        return f"skipped {event['topic']} [{event['type']}]: {event['reason']}\n"
     if kind == "client_connected":
         return f"client {event['client']} connected ({event['subprotocol'] or 'no subprotocol'})\n"
-    if kind == "client_disconnected":
-        return f"client {event['client']} disconnected\n"
-    if kind in ("subscribed", "unsubscribed"):
-        return f"client {event['client']} {kind} {event['topic']}\n"
-    if kind == "client_advertised":
-        return f"client {event['client']} publishes {event['topic']} [{event['type']}, {event['encoding']}]\n"
-    if kind == "client_unadvertised":
-        return f"client {event['client']} stopped publishing {event['topic']}\n"
-    if kind in ("client_publish_refused", "client_message_refused"):
-        return f"client {event['client']}: {event['topic']}: refused: {event['reason']}\n"
     if kind == "rates":
         rows = [[topic, f"{rate:.1f} msg/s"] for topic, rate in sorted(event["rates"].items())]
         return "\n".join(table_lines(rows)) + "\n" if rows else ""
+    if kind in _TEXTS:
+        return _TEXTS[kind].format(**event) + "\n"
     return f"{kind}: {event.get('reason', '')}\n"
 
 

@@ -209,7 +209,7 @@ def stats(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
     (ns), serialised sizes and, with ``stamps``, header stamps (ns) — never deserialising a message,
     so that a fast topic does not outrun the subscriber. ``subscribed {topic, type}`` (or
     ``not_published {topic}``, then heartbeats until the topic appears) first, per topic."""
-    period = params.get("period", 1.0)
+    period, stamps = params.get("period", 1.0), params.get("stamps")
     columns = ("sequence", "source", "received", "size", "stamp")
     receiver = Receiver(graph.node)
     try:
@@ -227,7 +227,7 @@ def stats(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
                     columns_of_topic["source"].append(info["source_timestamp"])
                     columns_of_topic["received"].append(info["received_timestamp"])
                     columns_of_topic["size"].append(len(data))
-                    columns_of_topic["stamp"].append(header_stamp_ns(data) if params.get("stamps") else None)
+                    columns_of_topic["stamp"].append(header_stamp_ns(data) if stamps else None)
             yield {"event": "batch", "topics": arrived}
     finally:
         receiver.close()

@@ -47,9 +47,9 @@ from websockets.asyncio.server import serve
 from websockets.exceptions import ConnectionClosed
 
 from roc.errors import RocError
-from roc.ros.bridge import TopicFilter
+from roc.ros.bridge import TopicFilter, receive_profile
 from roc.ros.cdr import serialize
-from roc.ros.dataplane import subscription_profile
+from roc.ros.dataplane import qos_profile
 from roc.ros.graph import Graph
 from roc.ros.interfaces import definition_path
 from roc.ros.messages import fill_message
@@ -319,7 +319,7 @@ class FoxgloveServer:
             if joins and topic.subscription is not None and topic.subscription.qos_profile.durability == LATCHED:
                 self._unsubscribe_ros(topic)  # a new subscription gets the kept messages for the new client too
             if topic.subscription is None:
-                qos = subscription_profile({"profile": "default"}, self.graph.node.get_publishers_info_by_topic(name))
+                qos = receive_profile(qos_profile({"profile": "default"}, self.graph.node.get_publishers_info_by_topic(name)))
                 log = topic.channel.log
 
                 def forward(data: bytes, topic: _Topic = topic) -> None:

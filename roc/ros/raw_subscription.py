@@ -158,16 +158,16 @@ class Receiver:
         self._wake.trigger_guard_condition()
 
     def _take_all(self) -> None:
-        wait_set, waited = None, {}
+        wait_set, size = None, -1
         try:
             while not self._stopping:
                 with self._changed:
                     subscriptions = dict(self._subscriptions)
-                if wait_set is None or len(subscriptions) != len(waited):
+                if len(subscriptions) != size:  # a wait set has room for a fixed number of subscriptions
                     if wait_set is not None:
                         wait_set.destroy_when_not_in_use()
-                    wait_set = _rclpy.WaitSet(len(subscriptions), 1, 0, 0, 0, 0, self._node.context.handle)
-                waited = subscriptions
+                    size = len(subscriptions)
+                    wait_set = _rclpy.WaitSet(size, 1, 0, 0, 0, 0, self._node.context.handle)
                 wait_set.clear_entities()
                 for subscription in subscriptions.values():
                     wait_set.add_subscription(subscription.handle)
