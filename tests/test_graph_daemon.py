@@ -5,8 +5,10 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import stat
 import subprocess
+import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -154,3 +156,46 @@ def test_the_graph_honours_the_discovery_range(talker):
     assert "/talker" in seen
     off = roc("node", "list", "--no-daemon", "--spin-time", "1", env={**talker, "ROS_AUTOMATIC_DISCOVERY_RANGE": "OFF"})
     assert off.returncode == 0 and "/talker" not in off.stdout.split()
+
+
+LATE_PUBLISHER = r'''
+import sys, time
+import rclpy
+from rclpy.qos import QoSProfile
+from std_msgs.msg import String
+rclpy.init()
+node = rclpy.create_node("late_publisher")
+publisher = node.create_publisher(String, "/late", QoSProfile(depth=100))
+time.sleep(1.5)
+for number in range(20):
+    publisher.publish(String(data=str(number)))
+    time.sleep(0.01)
+time.sleep(0.5)
+node.destroy_node()
+rclpy.shutdown()
+'''
+
+
+def test_a_long_running_daemon_hears_each_new_publisher_from_its_first_message(tmp_path):
+    """A Fast DDS participant that starts while an older one announces itself can miss the older one
+    until its next announcement (Fast DDS: every 3 s). Through a daemon that had run a while, echo
+    started up to 3 s late on a new publisher, in about half the runs; roc's participants announce
+    themselves every 0.5 s (roc/ros/fastdds_participant.xml)."""
+    env = graph_env(160, tmp_path)
+    try:
+        assert roc("daemon", "start", env=env).returncode == 0
+        time.sleep(4)  # the daemon announces itself periodically by now
+        echo = subprocess.Popen([str(BIN / "roc"), "topic", "echo", "/late", "std_msgs/msg/String", "--format", "json"],
+                                env=env, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        try:
+            time.sleep(1.5)  # subscribed in the daemon
+            for _ in range(5):  # five new publishers, one after the other, each sending 1.5 s after it started
+                subprocess.run([sys.executable, "-c", LATE_PUBLISHER], env=env, check=True, timeout=60)
+            time.sleep(0.5)
+        finally:
+            echo.send_signal(signal.SIGINT)
+            output = echo.communicate(timeout=15)[0]
+    finally:
+        stop_daemon(env)
+    received = [json.loads(line)["message"]["data"] for line in output.splitlines() if line.startswith("{")]
+    assert received == [str(number) for number in range(20)] * 5

@@ -196,36 +196,40 @@ def test_an_action_is_bridged_as_its_services_and_topics() -> None:
         ("topic", "/fib/_action/status", "/fob/_action/status", None)]
 
 
-def test_the_loop_guard_sets_roc_s_profile_or_checks_the_user_s(tmp_path: Path) -> None:
+def test_the_loop_guard_checks_the_user_s_profile(tmp_path: Path) -> None:
     from roc.errors import UsageError
-    from roc.ros.bridge import IGNORE_LOCAL_PROFILE, Route, loop_guard, two_way
+    from roc.ros.bridge import Route, loop_guard, two_way
+    from roc.ros.graph import BRIDGE_PROFILE
 
     both = [Route("/x", 1, 2), Route("/x", 2, 1)]
     assert two_way(both) == ["/x"] and two_way([Route("/x", 1, 2), Route("/x", 1, 3)]) == []
     assert two_way([Route("*", 1, 2), Route("/y", 2, 1)]) == ["*", "/y"]
-    environment: dict[str, str] = {}
-    loop_guard(both, environment)
-    assert environment["FASTRTPS_DEFAULT_PROFILES_FILE"] == str(IGNORE_LOCAL_PROFILE)
-    assert "<name>fastdds.ignore_local_endpoints</name>" in IGNORE_LOCAL_PROFILE.read_text()
+    loop_guard(both, {})  # the bridge's participants take BRIDGE_PROFILE
+    loop_guard(both, {"FASTRTPS_DEFAULT_PROFILES_FILE": str(BRIDGE_PROFILE)})  # inherited from roc: not the user's
+    assert "<name>fastdds.ignore_local_endpoints</name>" in BRIDGE_PROFILE.read_text()
     theirs = tmp_path / "profile.xml"
     theirs.write_text("<dds/>")
-    loop_guard([Route("/x", 1, 2)], mine := {"FASTRTPS_DEFAULT_PROFILES_FILE": str(theirs)})
-    assert mine == {"FASTRTPS_DEFAULT_PROFILES_FILE": str(theirs)}  # one way: the user's profile is enough
+    loop_guard([Route("/x", 1, 2)], {"FASTRTPS_DEFAULT_PROFILES_FILE": str(theirs)})  # one way: any profile
     with pytest.raises(UsageError, match=f"{theirs}: bridging /x both ways needs the participant property"):
         loop_guard(both, {"FASTRTPS_DEFAULT_PROFILES_FILE": str(theirs)})
     with pytest.raises(UsageError, match="/x: bridging both ways needs Fast DDS"):
         loop_guard(both, {"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"})
 
 
-@pytest.mark.parametrize(("environment", "transports"), [
-    ({}, "UDPv4"),
-    ({"RMW_IMPLEMENTATION": "rmw_fastrtps_dynamic_cpp"}, "UDPv4"),
-    ({"FASTDDS_BUILTIN_TRANSPORTS": "SHM"}, "SHM"),
-    ({"FASTRTPS_DEFAULT_PROFILES_FILE": "/mine.xml"}, None),
+@pytest.mark.parametrize(("environment", "chosen"), [
+    ({}, "bridge"),
+    ({"RMW_IMPLEMENTATION": "rmw_fastrtps_dynamic_cpp"}, "bridge"),
+    ({"FASTRTPS_DEFAULT_PROFILES_FILE": "participant"}, "bridge"),
+    ({"FASTRTPS_DEFAULT_PROFILES_FILE": "/mine.xml"}, "/mine.xml"),
+    ({"FASTDDS_DEFAULT_PROFILES_FILE": "/mine.xml"}, None),
     ({"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"}, None),
-], ids=["fast-dds", "dynamic", "user-transports", "user-profile", "cyclone"])
-def test_roc_receives_over_udp_unless_the_user_chose(environment: dict, transports: str | None) -> None:
-    from roc.ros.graph import receive_over_udp
+], ids=["fast-dds", "dynamic", "roc-s-own", "user-profile", "user-profile-fast-dds-3", "cyclone"])
+def test_roc_s_participants_take_roc_s_profile_unless_the_user_chose(environment: dict, chosen: str | None) -> None:
+    from roc.ros.graph import BRIDGE_PROFILE, PARTICIPANT_PROFILE, use_profile
 
-    receive_over_udp(environment)
-    assert environment.get("FASTDDS_BUILTIN_TRANSPORTS") == transports
+    ours = {"participant": str(PARTICIPANT_PROFILE), "bridge": str(BRIDGE_PROFILE)}
+    environment = {k: ours.get(v, v) for k, v in environment.items()}
+    use_profile(BRIDGE_PROFILE, environment)
+    assert environment.get("FASTRTPS_DEFAULT_PROFILES_FILE") == ours.get(chosen, chosen)
+    for profile in (PARTICIPANT_PROFILE, BRIDGE_PROFILE):  # every roc participant announces itself every 0.5 s
+        assert "<leaseAnnouncement><sec>0</sec><nanosec>500000000</nanosec></leaseAnnouncement>" in profile.read_text()

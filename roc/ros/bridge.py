@@ -11,7 +11,8 @@ second, so those that appear later are picked up. The bridge never prints: ``run
 Bridging both ways: each domain has one participant in this process, holding the publisher of one
 direction and the subscription of the other. Fast DDS's ``fastdds.ignore_local_endpoints`` keeps them
 from matching (rcl's ``ignore_local_publications``, which rclpy cannot set), so nothing the bridge
-publishes comes back to it: ``loop_guard`` arranges that before any participant is created.
+publishes comes back to it: the bridge's participants take BRIDGE_PROFILE, and ``loop_guard`` checks
+a profile the user chose instead.
 """
 
 from __future__ import annotations
@@ -29,12 +30,11 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from roc.errors import UsageError
 from roc.ros.bridge_services import ServiceLink
 from roc.ros.dataplane import RECEIVE_DEPTH, qos_profile
-from roc.ros.graph import PROFILE_VARIABLES, Graph
+from roc.ros.graph import BRIDGE_PROFILE, Graph, users_profile
 from roc.ros.types import message_class
 
 SCAN_SECONDS = 1.0
 BRIDGE_NODE = "_roc_bridge"
-IGNORE_LOCAL_PROFILE = Path(__file__).with_name("fastdds_ignore_local.xml")
 IGNORE_LOCAL_PROPERTY = "fastdds.ignore_local_endpoints"
 
 
@@ -100,26 +100,22 @@ def two_way(routes: list[Route]) -> list[str]:
 
 def loop_guard(routes: list[Route], environment: dict[str, str] = os.environ) -> None:
     """Keep the bridge's own publications from reaching its subscriptions (see the module docstring):
-    point Fast DDS at roc's profile, unless the user gave one; a user's profile must set the property
-    when a topic is bridged both ways, and other middlewares cannot bridge both ways."""
+    the bridge's Graphs take BRIDGE_PROFILE, unless the user gave a profile, which must then set the
+    property when a topic is bridged both ways; other middlewares cannot bridge both ways."""
     looping = two_way(routes)
     rmw = environment.get("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")
     if looping and not rmw.startswith("rmw_fastrtps"):
         raise UsageError(f"{looping[0]}: bridging both ways needs Fast DDS (RMW_IMPLEMENTATION=rmw_fastrtps_cpp), "
                          f"not {rmw}: {rmw} cannot keep the bridge from receiving its own messages")
-    own = next((environment[v] for v in PROFILE_VARIABLES if environment.get(v)), None)
-    if own is None:
-        for variable in PROFILE_VARIABLES:
-            environment[variable] = str(IGNORE_LOCAL_PROFILE)
-        return
-    if looping:
+    own = users_profile(environment)
+    if own is not None and looping:
         try:
             text = Path(own).read_text()
         except OSError as error:
             raise UsageError(f"{own}: cannot read the Fast DDS profile ({error.strerror})") from None
         if IGNORE_LOCAL_PROPERTY not in text:
             raise UsageError(f"{own}: bridging {looping[0]} both ways needs the participant property "
-                             f"{IGNORE_LOCAL_PROPERTY}=true in this Fast DDS profile (see {IGNORE_LOCAL_PROFILE})")
+                             f"{IGNORE_LOCAL_PROPERTY}=true in this Fast DDS profile (see {BRIDGE_PROFILE})")
 
 
 def receive_profile(offered: QoSProfile) -> QoSProfile:
@@ -147,13 +143,14 @@ class DomainBridge:
                  everything: tuple[int, int] | None = None):
         """``routes``: the topics and services named; ``everything`` (from, to): also every topic of the
         source domain whose name matches one of ``include`` (all when empty) and none of ``exclude``.
-        Sets up the ``loop_guard``: make it the process's first participant."""
+        Checks the ``loop_guard``; make it the process's first participant (Fast DDS reads its profile once)."""
         self.routes = [part for r in routes for part in (action_routes(r) if r.kind == "action" else [r])]
         self.wanted = TopicFilter(include, exclude)
         self.everything = everything
         loop_guard(self.routes + ([Route("*", *everything)] if everything else []))
         domains = {d for r in self.routes for d in (r.from_domain, r.to_domain)} | set(everything or ())
-        self.graphs = {domain: Graph(f"{BRIDGE_NODE}_{domain}", domain_id=domain, events=True) for domain in sorted(domains)}
+        self.graphs = {domain: Graph(f"{BRIDGE_NODE}_{domain}", domain_id=domain, events=True, profile=BRIDGE_PROFILE)
+                       for domain in sorted(domains)}
         self.links: dict[tuple, _TopicLink | ServiceLink] = {}
 
     def close(self) -> None:

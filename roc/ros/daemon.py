@@ -133,9 +133,6 @@ class Daemon:
 
 
 def main() -> None:
-    from roc.ros.graph import receive_over_udp
-
-    receive_over_udp()
     path = Path(sys.argv[1])
     daemon = Daemon(path)
     signal.signal(signal.SIGTERM, lambda *_: daemon.stopping.set())

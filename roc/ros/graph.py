@@ -12,6 +12,8 @@ from __future__ import annotations
 import os
 import threading
 import time
+from collections.abc import Mapping, MutableMapping
+from pathlib import Path
 from typing import Any
 
 import rclpy
@@ -81,31 +83,38 @@ def full_name(namespace: str, name: str) -> str:
 
 
 PROFILE_VARIABLES = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE")  # Fast DDS 2 (Jazzy), 3
-TRANSPORTS_VARIABLE = "FASTDDS_BUILTIN_TRANSPORTS"
+PARTICIPANT_PROFILE = Path(__file__).with_name("fastdds_participant.xml")
+BRIDGE_PROFILE = Path(__file__).with_name("fastdds_bridge.xml")
 
 
-def receive_over_udp(environment=os.environ) -> None:
-    """Have the Fast DDS participants this process creates from now on take data over UDP only, for
-    the daemon and daemon-less streams. Fast DDS hands a message to readers on the same machine
-    through the publisher's shared-memory segment, and one slow reader elsewhere (ros2 topic echo at
-    5 kHz) keeps that segment full: then every reader of the publisher loses messages, repaired
-    seconds later or never (measured: roc echo got 7-24 k of 50 k messages, with 2 s delays; over
-    UDP 47 k, the rest reported lost). Messages larger than the segment (512 KB) go by UDP anyway.
-    Left alone when the user chose transports or a profile, or another middleware."""
+def users_profile(environment: Mapping[str, str] = os.environ) -> str | None:
+    """The Fast DDS profile file the user chose, if any (roc's own do not count)."""
+    ours = {str(PARTICIPANT_PROFILE), str(BRIDGE_PROFILE)}
+    return next((environment[v] for v in PROFILE_VARIABLES if environment.get(v) and environment[v] not in ours), None)
+
+
+def use_profile(profile: Path, environment: MutableMapping[str, str] = os.environ) -> None:
+    """Have Fast DDS load ``profile`` for this process's participants (it reads the file once, at the
+    first), unless the user chose one or the middleware is not Fast DDS."""
     rmw = environment.get("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")
-    if rmw.startswith("rmw_fastrtps") and not any(environment.get(v) for v in (TRANSPORTS_VARIABLE, *PROFILE_VARIABLES)):
-        environment[TRANSPORTS_VARIABLE] = "UDPv4"
+    if rmw.startswith("rmw_fastrtps") and users_profile(environment) is None:
+        for variable in PROFILE_VARIABLES:
+            environment[variable] = str(profile)
 
 
 class Graph:
     """A hidden rclpy node in its own context, spun in a background thread (for service calls); in
-    ``domain_id`` when given, else in the environment's ROS domain."""
+    ``domain_id`` when given, else in the environment's ROS domain. Its participant takes Fast DDS's
+    settings from ``profile`` (unless the user chose a profile file): PARTICIPANT_PROFILE, or
+    BRIDGE_PROFILE for a bridge's. Both announce the participant every 0.5 s."""
 
-    def __init__(self, node_name: str | None = None, domain_id: int | None = None, events: bool = False) -> None:
+    def __init__(self, node_name: str | None = None, domain_id: int | None = None, events: bool = False,
+                 profile: Path = PARTICIPANT_PROFILE) -> None:
         """``events``: spin with rclpy's C++ EventsExecutor, which takes a message in a fraction of the
         Python executor's time (at 5 kHz: no loss and 0.2 ms instead of 10 % loss and 60 ms here). In
         rclpy 7.1.6 it never calls a callback that takes message info, so echo and hz take their
         messages with roc.ros.raw_subscription instead."""
+        use_profile(profile)
         self.context = Context()
         rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO, domain_id=domain_id)
         self.node = Node(node_name or f"_roc_{os.getpid()}", context=self.context, start_parameter_services=False,

@@ -23,9 +23,8 @@ def local_stream(method: str, params: dict[str, Any], node_name: str | None = No
                  **in_process: Any) -> Iterator[dict[str, Any]]:
     """A stream without the daemon: its endpoint on a fresh participant of this process, on a node
     named ``node_name`` (default: a hidden one)."""
-    from roc.ros.graph import Graph, receive_over_udp
+    from roc.ros.graph import Graph
 
-    receive_over_udp()
     graph = Graph(node_name)
     try:
         yield from run_on(graph, method, params, **in_process)

@@ -16,8 +16,8 @@ Topics are looked for again every second, so a publisher that appears later is p
 (roc.ros.zenoh_services), announced the same way (``roc/announce/ZID/NAME/-/TYPE``).
 
 No loops: the link forwards only topics with a publisher other than a bridge's (so a topic the link
-only republishes goes no further); the link's participant ignores its own endpoints (the Fast DDS
-profile of ``loop_guard``), so what it publishes never reaches its own subscriptions even when a
+only republishes goes no further); the link's participant ignores its own endpoints (Fast DDS's
+BRIDGE_PROFILE, or the user's, checked by ``loop_guard``), so what it publishes never reaches its own subscriptions even when a
 topic has publishers on both sides; and its Zenoh subscribers take remote samples only, so a link
 never receives its own puts. The link never prints: ``run`` yields status events.
 """
@@ -50,7 +50,7 @@ from roc.ros.bridge import (
     receive_profile,
 )
 from roc.ros.dataplane import qos_profile
-from roc.ros.graph import Graph
+from roc.ros.graph import BRIDGE_PROFILE, Graph
 from roc.ros.types import message_class
 from roc.ros.zenoh_services import ServiceOffer, ServiceProxy
 
@@ -168,7 +168,7 @@ class ZenohLink:
         try:
             # every topic may have publishers on both sides, so the link may both publish and subscribe it
             loop_guard([Route(name, domain, domain) for name in topics] + [Route("*", domain, domain)] * everything)
-            self.graph = Graph(f"{LINK_NODE}_{domain}", domain_id=domain, events=True)
+            self.graph = Graph(f"{LINK_NODE}_{domain}", domain_id=domain, events=True, profile=BRIDGE_PROFILE)
             self.zid = str(self.session.zid())
             self.subscribers = [
                 self.session.declare_subscriber(f"{VOLATILE_PREFIX}/**", self._received,
