@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """A paced publisher for dataplane_bench.py and bridge_bench.py: std_msgs/String on TOPIC at RATE Hz
 for SECONDS seconds, after WAIT seconds (for the consumers to subscribe). Prints the count and the
-true rate as JSON. ``stamped``: each message's data is its publication time (``time.time_ns()``), for
+true rate as JSON, and the rate of the last HZ_WINDOW messages (``tail_rate``: what a topic hz's
+last report should show, as the publisher's pace can drift under load). ``stamped``: each message's data is its publication time (``time.time_ns()``), for
 latency (counting_subscriber.py ``latency``).
 
 It raises its own priority (nice -5) where allowed: the consumers it measures share two cores with
@@ -12,6 +13,7 @@ it, and a starved publisher sends in bursts, so its rate would stop being a trut
 
 from __future__ import annotations
 
+import collections
 import json
 import os
 import sys
@@ -20,6 +22,8 @@ import time
 import rclpy
 from rclpy.qos import QoSProfile
 from std_msgs.msg import String
+
+HZ_WINDOW = 10000  # roc's and ros2's topic hz measure over the last 10000 messages by default
 
 
 def main() -> None:
@@ -35,6 +39,7 @@ def main() -> None:
     message = String(data="x" * 64)
     time.sleep(wait)
     period, count = 1.0 / rate, 0
+    sent = collections.deque(maxlen=HZ_WINDOW)
     start = time.perf_counter()
     while (now := time.perf_counter()) - start < seconds:
         due = start + count * period
@@ -43,9 +48,11 @@ def main() -> None:
         if stamped:
             message.data = str(time.time_ns())
         publisher.publish(message)
+        sent.append(time.perf_counter())
         count += 1
     elapsed = time.perf_counter() - start
-    print(json.dumps({"count": count, "rate": count / elapsed}), flush=True)
+    tail_rate = (len(sent) - 1) / (sent[-1] - sent[0])
+    print(json.dumps({"count": count, "rate": count / elapsed, "tail_rate": tail_rate}), flush=True)
     node.destroy_node()
     rclpy.shutdown()
 
