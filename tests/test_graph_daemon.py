@@ -73,6 +73,19 @@ def test_lifecycle(talker):
                                                                                             "count": 0}
 
 
+def test_the_daemon_is_out_of_the_terminal_s_reach_but_in_its_session(talker):
+    """Its own process group: the terminal's Ctrl+C goes to the foreground group only; hang-up is
+    ignored. The caller's session: a session of its own is a scheduling group of its own on Linux,
+    where a busy machine starved the daemon for seconds (roc.ros.client.start_daemon)."""
+    assert roc("daemon", "start", env=talker).returncode == 0
+    pid = status(talker)["pid"]
+    assert os.getpgid(pid) == pid
+    assert os.getsid(pid) == os.getsid(0)
+    os.kill(pid, signal.SIGHUP)
+    time.sleep(0.5)
+    assert status(talker)["pid"] == pid
+
+
 def test_concurrent_clients_share_one_daemon(talker):
     env = talker
     with ThreadPoolExecutor(6) as pool:

@@ -137,6 +137,7 @@ def main() -> None:
     daemon = Daemon(path)
     signal.signal(signal.SIGTERM, lambda *_: daemon.stopping.set())
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGHUP, signal.SIG_IGN)  # it outlives the terminal that started it
     os.chdir("/")
     daemon.serve()
 
