@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import array
 import math
+import sys
 from collections.abc import Callable, Iterable
 from functools import lru_cache, partial
 from typing import Any
 
-import numpy
 import yaml
 from rosidl_parser import definition as idl
 
@@ -37,7 +37,7 @@ INT_RANGES = {
 }
 TYPECODES = {"int8": "b", "uint8": "B", "char": "B", "int16": "h", "uint16": "H", "int32": "i",
              "uint32": "I", "int64": "q", "uint64": "Q", "float": "f", "double": "d"}
-FLOAT32_MAX = float(numpy.finfo(numpy.float32).max)
+FLOAT32_MAX = 3.4028234663852886e38  # numpy.finfo(numpy.float32).max
 # IDL names of basic types -> the names people write in .msg files (for error messages).
 MSG_NAMES = {"boolean": "bool", "octet": "byte", "float": "float32", "double": "float64"}
 
@@ -92,6 +92,14 @@ def message_to_dict(msg: Any, *, no_arr: bool = False, no_str: bool = False,
             for name, slot in fields(type(msg))}
 
 
+def _is_numpy(value: Any, kind: str) -> bool:
+    """Whether ``value`` is a numpy ``kind`` (``ndarray``, ``generic``, ``number``). Only once numpy is
+    imported can a value be one (rclpy's message classes import it for their arrays); roc itself does
+    not import it here, as that would cost every echo and pub 0.15 s."""
+    numpy = sys.modules.get("numpy")
+    return numpy is not None and isinstance(value, getattr(numpy, kind))
+
+
 def value_to_data(value: Any, *, no_arr: bool = False, no_str: bool = False,
                   truncate_length: int | None = None) -> Any:
     """A message or a field value (``echo --field``) as plain data."""
@@ -100,7 +108,7 @@ def value_to_data(value: Any, *, no_arr: bool = False, no_str: bool = False,
 
 def _to_data(value: Any, slot: Any, no_arr: bool, no_str: bool, limit: int | None) -> Any:
     if isinstance(value, (bool, int, float)):
-        return value.item() if isinstance(value, numpy.generic) else value
+        return value.item() if _is_numpy(value, "generic") else value
     if isinstance(value, str):
         if no_str:
             return f"<string length: <{len(value)}>>"
@@ -109,17 +117,17 @@ def _to_data(value: Any, slot: Any, no_arr: bool, no_str: bool, limit: int | Non
         if limit is not None and len(value) > limit:
             return value[:limit].decode("latin-1") + "..."
         return value.decode("latin-1")
-    if isinstance(value, (list, tuple, array.array, numpy.ndarray)):
+    if isinstance(value, (list, tuple, array.array)) or _is_numpy(value, "ndarray"):
         if no_arr and slot is not None:
             return _array_summary(value, slot)
         truncated = limit is not None and len(value) > limit
         items = value[:limit] if truncated else value
-        if isinstance(items, (array.array, numpy.ndarray)):
+        if isinstance(items, array.array) or _is_numpy(items, "ndarray"):
             data = items.tolist()
         else:
             data = [_to_data(item, None, no_arr, no_str, limit) for item in items]
         return data + ["..."] if truncated else data
-    if isinstance(value, numpy.generic):
+    if _is_numpy(value, "generic"):
         return value.item()
     return message_to_dict(value, no_arr=no_arr, no_str=no_str, truncate_length=limit)
 
@@ -152,7 +160,7 @@ def _csv_join(parts: Iterable[str]) -> str:
 
 
 def _csv(value: Any, slot: Any, no_arr: bool, no_str: bool, limit: int | None) -> str:
-    if isinstance(value, (list, tuple, array.array, numpy.ndarray)):
+    if isinstance(value, (list, tuple, array.array)) or _is_numpy(value, "ndarray"):
         if no_arr and slot is not None:
             return _array_summary(value, slot)
         parts = [_csv(item, None, no_arr, no_str, limit)
@@ -166,7 +174,7 @@ def _csv(value: Any, slot: Any, no_arr: bool, no_str: bool, limit: int | None) -
         return value[:limit] + "..." if limit is not None and len(value) > limit else value
     if isinstance(value, bytes):
         return str(value[:limit] + b"..." if limit is not None and len(value) > limit else value)
-    if isinstance(value, (bool, int, float, numpy.number)):
+    if isinstance(value, (bool, int, float)) or _is_numpy(value, "number"):
         return str(value)
     return message_to_csv(value, no_arr=no_arr, no_str=no_str, truncate_length=limit)
 
@@ -385,7 +393,7 @@ def _sequence(value: Any, slot: Any, where: str, stamps: StampSetters | None) ->
     if isinstance(value, (bytes, bytearray)) and isinstance(element, idl.BasicType) \
             and element.typename in ("octet", "uint8", "char"):
         value = list(value)
-    if isinstance(value, (array.array, numpy.ndarray)):
+    if isinstance(value, array.array) or _is_numpy(value, "ndarray"):
         value = value.tolist()
     if not isinstance(value, (list, tuple)):
         raise MessageValueError(f"{where}: expected a list of {_element_name(element)}, got {_show(value)}")
@@ -409,6 +417,8 @@ def _numeric_array(values: list | tuple, code: str, typename: str) -> array.arra
     except (TypeError, OverflowError):
         return None
     if code == "f":
+        import numpy
+
         magnitudes = numpy.abs(numpy.frombuffer(numbers, dtype=numpy.float64))
         if ((magnitudes > FLOAT32_MAX) & numpy.isfinite(magnitudes)).any():
             return None
