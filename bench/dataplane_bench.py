@@ -35,6 +35,7 @@ from graph_bench import (  # noqa: E402
     tool,
     tool_env,
 )
+from paced_publisher import HZ_WINDOW  # noqa: E402
 
 GRAPH = [[{"name": "talker", "publishers": [
               {"topic": "chatter", "type": "std_msgs/msg/String", "values": {"data": "hello"}, "rate_hz": 10}]}],
@@ -127,7 +128,7 @@ def main() -> int:
             def error(name: str) -> str:
                 return "no output" if row[name] is None else f"{row[name]:.1f} Hz ({(row[name] / truth - 1) * 100:+.2f}%)"
             print(f"\n{rate:g} Hz for {options.seconds:g} s: published {row['published']} at {row['true rate']:.1f} Hz, "
-                  f"the last {min(row['published'], 10000)} at {truth:.1f} Hz")
+                  f"the last {min(row['published'], HZ_WINDOW)} at {truth:.1f} Hz")
             print(f"  hz: roc {error('roc hz')}, ros2 {error('ros2 hz')}")
             unaccounted = row["published"] - row["roc echo"] - row["roc echo lost"]
             print(f"  received: rclpy subscriber {row['rclpy subscriber']}, roc echo {row['roc echo']} "

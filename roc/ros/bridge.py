@@ -30,7 +30,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from roc.errors import UsageError
 from roc.ros.bridge_services import ServiceLink
 from roc.ros.dataplane import RECEIVE_DEPTH, qos_profile
-from roc.ros.graph import BRIDGE_PROFILE, Graph, users_profile
+from roc.ros.graph import BRIDGE_PROFILE, Graph, middleware, users_profile
 from roc.ros.types import message_class
 
 SCAN_SECONDS = 1.0
@@ -103,7 +103,7 @@ def loop_guard(routes: list[Route], environment: dict[str, str] = os.environ) ->
     the bridge's Graphs take BRIDGE_PROFILE, unless the user gave a profile, which must then set the
     property when a topic is bridged both ways; other middlewares cannot bridge both ways."""
     looping = two_way(routes)
-    rmw = environment.get("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")
+    rmw = middleware(environment)
     if looping and not rmw.startswith("rmw_fastrtps"):
         raise UsageError(f"{looping[0]}: bridging both ways needs Fast DDS (RMW_IMPLEMENTATION=rmw_fastrtps_cpp), "
                          f"not {rmw}: {rmw} cannot keep the bridge from receiving its own messages")

@@ -93,11 +93,15 @@ def users_profile(environment: Mapping[str, str] = os.environ) -> str | None:
     return next((environment[v] for v in PROFILE_VARIABLES if environment.get(v) and environment[v] not in ours), None)
 
 
+def middleware(environment: Mapping[str, str] = os.environ) -> str:
+    """The RMW implementation rcl will load (Fast DDS unless RMW_IMPLEMENTATION says otherwise)."""
+    return environment.get("RMW_IMPLEMENTATION") or "rmw_fastrtps_cpp"
+
+
 def use_profile(profile: Path, environment: MutableMapping[str, str] = os.environ) -> None:
     """Have Fast DDS load ``profile`` for this process's participants (it reads the file once, at the
     first), unless the user chose one or the middleware is not Fast DDS."""
-    rmw = environment.get("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")
-    if rmw.startswith("rmw_fastrtps") and users_profile(environment) is None:
+    if middleware(environment).startswith("rmw_fastrtps") and users_profile(environment) is None:
         for variable in PROFILE_VARIABLES:
             environment[variable] = str(profile)
 

@@ -100,6 +100,11 @@ def _is_numpy(value: Any, kind: str) -> bool:
     return numpy is not None and isinstance(value, getattr(numpy, kind))
 
 
+def _is_number_array(value: Any) -> bool:
+    """An array.array or numpy array: numbers in one buffer (``tolist()`` gives them as Python values)."""
+    return isinstance(value, array.array) or _is_numpy(value, "ndarray")
+
+
 def value_to_data(value: Any, *, no_arr: bool = False, no_str: bool = False,
                   truncate_length: int | None = None) -> Any:
     """A message or a field value (``echo --field``) as plain data."""
@@ -117,12 +122,12 @@ def _to_data(value: Any, slot: Any, no_arr: bool, no_str: bool, limit: int | Non
         if limit is not None and len(value) > limit:
             return value[:limit].decode("latin-1") + "..."
         return value.decode("latin-1")
-    if isinstance(value, (list, tuple, array.array)) or _is_numpy(value, "ndarray"):
+    if isinstance(value, (list, tuple)) or _is_number_array(value):
         if no_arr and slot is not None:
             return _array_summary(value, slot)
         truncated = limit is not None and len(value) > limit
         items = value[:limit] if truncated else value
-        if isinstance(items, array.array) or _is_numpy(items, "ndarray"):
+        if _is_number_array(items):
             data = items.tolist()
         else:
             data = [_to_data(item, None, no_arr, no_str, limit) for item in items]
@@ -160,7 +165,7 @@ def _csv_join(parts: Iterable[str]) -> str:
 
 
 def _csv(value: Any, slot: Any, no_arr: bool, no_str: bool, limit: int | None) -> str:
-    if isinstance(value, (list, tuple, array.array)) or _is_numpy(value, "ndarray"):
+    if isinstance(value, (list, tuple)) or _is_number_array(value):
         if no_arr and slot is not None:
             return _array_summary(value, slot)
         parts = [_csv(item, None, no_arr, no_str, limit)
@@ -393,7 +398,7 @@ def _sequence(value: Any, slot: Any, where: str, stamps: StampSetters | None) ->
     if isinstance(value, (bytes, bytearray)) and isinstance(element, idl.BasicType) \
             and element.typename in ("octet", "uint8", "char"):
         value = list(value)
-    if isinstance(value, array.array) or _is_numpy(value, "ndarray"):
+    if _is_number_array(value):
         value = value.tolist()
     if not isinstance(value, (list, tuple)):
         raise MessageValueError(f"{where}: expected a list of {_element_name(element)}, got {_show(value)}")
