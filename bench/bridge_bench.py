@@ -11,7 +11,9 @@ percentile, direct and bridged, and what the bridge adds. Then the same through 
     python bench/bridge_bench.py [--rates 1000 5000] [--seconds 5] [--links domain zenoh]
 
 Localhost discovery. Target (issue 15): no loss at 1 kHz, under 1 % at 5 kHz, added median latency
-under 1 ms. Every process shares the machine's cores (2 here), the publisher's and subscribers' too.
+under 1 ms. Every process shares the machine's cores (2 here), the publisher's and subscribers' too, so
+each run also prints the CPU each process used while the publisher sent (percent of one core) and their
+sum: latency through the bridges grows as the cores run out.
 """
 
 from __future__ import annotations
@@ -25,6 +27,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+import psutil
 
 HERE = Path(__file__).resolve().parent
 ROC = Path(sys.executable).parent / "roc"
@@ -65,6 +69,28 @@ def _bridges(topic: str, zenoh: bool) -> list[tuple[list, int]]:
             ([ROC, "bridge", "--zenoh-connect", endpoint, "--domain", TARGET, topic], TARGET)]
 
 
+def _cpu_seconds(processes: dict[str, subprocess.Popen]) -> dict[str, float]:
+    """CPU seconds each process (all its threads) has used so far."""
+    used = {}
+    for name, process in processes.items():
+        try:
+            times = psutil.Process(process.pid).cpu_times()
+            used[name] = times.user + times.system
+        except psutil.NoSuchProcess:
+            pass
+    return used
+
+
+def _cpu_while_sending(processes: dict[str, subprocess.Popen], seconds: float) -> dict[str, float]:
+    """Percent of one core each process used over the middle of the publisher's sending (``seconds``
+    long, starting WAIT_SECONDS after it was started, which is now)."""
+    time.sleep(WAIT_SECONDS + 0.1 * seconds)
+    before, start = _cpu_seconds(processes), time.monotonic()
+    time.sleep(0.8 * seconds)
+    after, elapsed = _cpu_seconds(processes), time.monotonic() - start
+    return {name: 100 * (after[name] - before[name]) / elapsed for name in after if name in before}
+
+
 def rate_run(rate: float, seconds: float, work: Path, zenoh: bool = False) -> dict:
     topic = f"/bridged_{int(rate)}"
     subscriber = [sys.executable, HERE / "counting_subscriber.py", topic, "latency", "events"]
@@ -76,12 +102,13 @@ def rate_run(rate: float, seconds: float, work: Path, zenoh: bool = False) -> di
     publisher = _start([sys.executable, HERE / "paced_publisher.py", topic, rate, seconds, WAIT_SECONDS, "stamped"],
                        SOURCE, outputs["publisher"])
     try:
+        cpu = _cpu_while_sending({"publisher": publisher, **processes}, seconds)
         publisher.wait(timeout=WAIT_SECONDS + seconds + 60)
         time.sleep(1.0)  # the last messages drain
     finally:
         for process in (publisher, *processes.values()):
             _stop(process)
-    return {name: _result(outputs[name]) for name in ("publisher", "direct", "bridged")}
+    return {"cpu": cpu, **{name: _result(outputs[name]) for name in ("publisher", "direct", "bridged")}}
 
 
 LINKS = {"domain": "roc bridge (domain to domain)", "zenoh": "Zenoh (two roc bridge processes)"}
@@ -110,6 +137,10 @@ def main() -> int:
                   f"{direct.get('median_ms', float('nan')):>7.2f} {direct.get('p99_ms', float('nan')):>7.2f} | "
                   f"{bridged['count']:>7} {sent - bridged['count']:>6} {bridged.get('median_ms', float('nan')):>7.2f} "
                   f"{bridged.get('p99_ms', float('nan')):>7.2f} | {added[0]:>9.2f} {added[1]:>9.2f}")
+            cpu = result["cpu"]
+            print(f"{'':>6} {'':>6} CPU while sending, % of one core: "
+                  + ", ".join(f"{name} {percent:.0f}" for name, percent in cpu.items())
+                  + f"; all {sum(cpu.values()):.0f} of {100 * psutil.cpu_count():.0f}")
             allowed = 0.0 if rate <= 1000 else 0.01
             verdicts.append(f"{LINKS[link]}, {rate:.0f} Hz: loss {loss:.2%} (target {'none' if not allowed else 'under 1%'}), "
                             f"added median {added[0]:.2f} ms (target under 1 ms): "
