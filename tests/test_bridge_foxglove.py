@@ -59,11 +59,13 @@ class Bridge:
         self.events: list[dict] = []
         self.event(lambda e: e["event"] == "serving")
 
-    def event(self, wanted, seconds: float = 30) -> dict:
-        """The first event (seen so far or to come within ``seconds``) for which ``wanted`` is true."""
+    def event(self, wanted, seconds: float = 30, after: dict | None = None) -> dict:
+        """The first event (seen so far or to come within ``seconds``; only those that came after the
+        event ``after``, if given) for which ``wanted`` is true."""
         deadline = time.monotonic() + seconds
         while True:
-            found = next((e for e in self.events if wanted(e)), None)
+            start = 0 if after is None else next(i for i, e in enumerate(self.events) if e is after) + 1
+            found = next((e for e in self.events[start:] if wanted(e)), None)
             if found:
                 return found
             try:
@@ -195,8 +197,8 @@ def test_a_client_gets_channels_with_ros2msg_schemas_and_cdr_messages(bridge: Br
         assert _deserialize(client.subscribe(2, "/cmd"), "geometry_msgs/msg/Twist").linear.x == 0.0
         connected = bridge.event(lambda e: e["event"] == "client_connected")
         assert connected["subprotocol"] == subprotocol
-        assert bridge.event(lambda e: e["event"] == "subscribed" and e["topic"] == "/cmd")
-        rates = bridge.event(lambda e: e["event"] == "rates" and e["rates"].get("/chatter", 0) > 0)
+        subscribed = bridge.event(lambda e: e["event"] == "subscribed" and e["topic"] == "/cmd")
+        rates = bridge.event(lambda e: e["event"] == "rates" and e["rates"].get("/chatter", 0) > 0, after=subscribed)
         assert set(rates["rates"]) == {"/chatter", "/cmd"}  # only what clients subscribe to
     assert bridge.event(lambda e: e["event"] == "unsubscribed" and e["topic"] == "/chatter")
 
