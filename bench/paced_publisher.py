@@ -2,8 +2,8 @@
 """A paced publisher for dataplane_bench.py and bridge_bench.py: std_msgs/String on TOPIC at RATE Hz
 for SECONDS seconds, after WAIT seconds (for the consumers to subscribe). Prints the count and the
 true rate as JSON, and the rate of the last HZ_WINDOW messages (``tail_rate``: what a topic hz's
-last report should show, as the publisher's pace can drift under load). ``stamped``: each message's data is its publication time (``time.time_ns()``), for
-latency (counting_subscriber.py ``latency``).
+last report should show, as the publisher's pace can drift under load). ``stamped``: each message's
+data is its publication time (``time.time_ns()``), for latency (counting_subscriber.py ``latency``).
 
 It raises its own priority (nice -5) where allowed: the consumers it measures share two cores with
 it, and a starved publisher sends in bursts, so its rate would stop being a truth to compare with.
