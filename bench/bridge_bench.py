@@ -13,7 +13,8 @@ percentile, direct and bridged, and what the bridge adds. Then the same through 
 Localhost discovery. Target (issue 15): no loss at 1 kHz, under 1 % at 5 kHz, added median latency
 under 1 ms. Every process shares the machine's cores (2 here), the publisher's and subscribers' too, so
 each run also prints the CPU each process used while the publisher sent (percent of one core) and their
-sum: latency through the bridges grows as the cores run out.
+sum: latency through the bridges grows as the cores run out. Every process runs at the same priority
+(the publisher is not ``steady``: see paced_publisher.py).
 """
 
 from __future__ import annotations
@@ -120,14 +121,14 @@ def main() -> int:
     parser.add_argument("--seconds", type=float, default=5.0)
     parser.add_argument("--links", nargs="+", choices=sorted(LINKS), default=list(LINKS))
     args = parser.parse_args()
-    work = Path(tempfile.mkdtemp(prefix="roc-bridge-bench-"))
     print(f"load average before: {os.getloadavg()[0]:.2f}")
     print(f"{'link':>6} {'rate':>6} {'sent':>7} | {'direct':>7} {'lost':>6} {'med ms':>7} {'p99 ms':>7} | "
           f"{'bridged':>7} {'lost':>6} {'med ms':>7} {'p99 ms':>7} | {'added med':>9} {'added p99':>9}")
     verdicts = []
     for link in args.links:
         for rate in args.rates:
-            result = rate_run(rate, args.seconds, work, link == "zenoh")
+            with tempfile.TemporaryDirectory(prefix="roc-bridge-bench-") as work:
+                result = rate_run(rate, args.seconds, Path(work), link == "zenoh")
             sent = result["publisher"].get("count", 0)
             direct, bridged = result["direct"], result["bridged"]
             loss = (sent - bridged["count"]) / sent if sent else 1.0

@@ -79,7 +79,8 @@ def rate_run(env: dict[str, str], rate: float, seconds: float, work: Path) -> di
     try:
         time.sleep(3)  # every consumer subscribed
         publisher = subprocess.run([sys.executable, str(here / "paced_publisher.py"), topic, str(rate), str(seconds),
-                                    "1"], env=tool_env(env, True), capture_output=True, text=True, timeout=seconds + 60)
+                                    "1", "steady"], env=tool_env(env, True), capture_output=True, text=True,
+                                   timeout=seconds + 60)
         truth = json.loads(publisher.stdout)
         time.sleep(1.5)
         settled(outputs["roc echo"])  # roc's echo delays rather than drops: let it print what it holds

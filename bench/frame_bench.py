@@ -77,7 +77,12 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=5)
     args = parser.parse_args()
-    runtime = Path(tempfile.mkdtemp(prefix="roc-frame-bench-"))
+    with tempfile.TemporaryDirectory(prefix="roc-frame-bench-") as runtime:
+        return measure(Path(runtime), args.runs)
+
+
+def measure(runtime: Path, runs: int) -> int:
+    """The cases' median times, roc's daemon in ``runtime``."""
     env = sourced_env(runtime)
     echo = [ROC, "frame", "echo", "map", "laser", "--once"]
     stop = [ROC, "daemon", "stop"]
@@ -93,12 +98,12 @@ def main() -> int:
         assert tree.stdout.readline().strip() == "ready"
         timed(echo, env)  # the daemon started and discovered
         times: dict[str, list[float]] = {name: [] for name in cases}
-        for _ in range(args.runs):
+        for _ in range(runs):
             for name, case in cases.items():
                 times[name].append(case())
             time.sleep(2)  # the daemon started by the last case has discovered the graph
         reference = statistics.median(times["fresh rclpy process"])
-        print(f"frame echo map laser --once, median of {args.runs} runs:")
+        print(f"frame echo map laser --once, median of {runs} runs:")
         for name, values in times.items():
             median = statistics.median(values)
             print(f"  {name:26} {median:6.3f} s   {median / reference:5.2f} x the fresh rclpy process")

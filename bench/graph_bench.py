@@ -77,18 +77,19 @@ def live_graph(domain: int, specs: list):
     reason = install_oracle()
     if reason:
         raise SystemExit(f"the ros2 CLI is not available: {reason}")
-    work = Path(tempfile.mkdtemp(prefix="roc-bench-"))
-    env = graph_env(domain, work)
-    env["ROS_DOMAIN_ID"] = str(domain)
-    processes = start_nodes(specs, env)
-    try:
-        for name in ("roc", "ros2"):
-            subprocess.run([tool(name), "daemon", "start"], env=env, capture_output=True, timeout=60)
-        time.sleep(4)
-        yield env, work
-    finally:
-        stop_daemon(env)
-        stop_all(processes)
+    with tempfile.TemporaryDirectory(prefix="roc-bench-") as directory:
+        work = Path(directory)
+        env = graph_env(domain, work)
+        env["ROS_DOMAIN_ID"] = str(domain)
+        processes = start_nodes(specs, env)
+        try:
+            for name in ("roc", "ros2"):
+                subprocess.run([tool(name), "daemon", "start"], env=env, capture_output=True, timeout=60)
+            time.sleep(4)
+            yield env, work
+        finally:
+            stop_daemon(env)
+            stop_all(processes)
 
 
 def compare(env: dict[str, str], runs: int, extra: tuple[str, ...], boot: bool) -> list[tuple]:

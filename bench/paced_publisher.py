@@ -1,14 +1,18 @@
 #!/usr/bin/env python3
-"""A paced publisher for dataplane_bench.py and bridge_bench.py: std_msgs/String on TOPIC at RATE Hz
-for SECONDS seconds, after WAIT seconds (for the consumers to subscribe). Prints the count and the
-true rate as JSON, and the rate of the last HZ_WINDOW messages (``tail_rate``: what a topic hz's
-last report should show, as the publisher's pace can drift under load). ``stamped``: each message's
-data is its publication time (``time.time_ns()``), for latency (counting_subscriber.py ``latency``).
+"""A paced publisher for dataplane_bench.py, bridge_bench.py and foxglove_bench.py: std_msgs/String
+on TOPIC at RATE Hz for SECONDS seconds, after WAIT seconds (for the consumers to subscribe). Prints
+the count and the true rate as JSON, and the rate of the last HZ_WINDOW messages (``tail_rate``:
+what a topic hz's last report should show, as the publisher's pace can drift under load).
+``stamped``: each message's data is its publication time (``time.time_ns()``), for latency
+(counting_subscriber.py ``latency``).
 
-It raises its own priority (nice -5) where allowed: the consumers it measures share two cores with
-it, and a starved publisher sends in bursts, so its rate would stop being a truth to compare with.
+``steady``: it raises its own priority (nice -5) where allowed, for benchmarks that compare a rate
+with the true one: the consumers it measures share two cores with it, and a starved publisher sends
+in bursts. Latency benchmarks leave it off: the stamp is taken as each message is sent, so a late
+send does not skew it, while a publisher that outranks every other process makes the processes it
+measures wait for a core (through roc bridge's Zenoh link, 0.4 to 0.6 ms more added median at 5 kHz).
 
-    python bench/paced_publisher.py TOPIC RATE SECONDS WAIT [stamped]
+    python bench/paced_publisher.py TOPIC RATE SECONDS WAIT [stamped] [steady]
 """
 
 from __future__ import annotations
@@ -28,11 +32,13 @@ HZ_WINDOW = 10000  # roc's and ros2's topic hz measure over the last 10000 messa
 
 def main() -> None:
     topic, rate, seconds, wait = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
-    stamped = sys.argv[5:] == ["stamped"]
-    try:
-        os.nice(-5)
-    except PermissionError:
-        print("paced_publisher: cannot raise its priority (not root); under load its rate may drift", file=sys.stderr)
+    stamped, steady = "stamped" in sys.argv[5:], "steady" in sys.argv[5:]
+    if steady:
+        try:
+            os.nice(-5)
+        except PermissionError:
+            print("paced_publisher: cannot raise its priority (not root); under load its rate may drift",
+                  file=sys.stderr)
     rclpy.init()
     node = rclpy.create_node("paced_publisher")
     publisher = node.create_publisher(String, topic, QoSProfile(depth=1000))
