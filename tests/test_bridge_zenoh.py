@@ -54,6 +54,10 @@ def _events_until(process: subprocess.Popen, done: Callable[[list[dict]], bool],
     return events
 
 
+def _thread_names(process: subprocess.Popen) -> set[str]:
+    return {task.joinpath("comm").read_text().strip() for task in Path(f"/proc/{process.pid}/task").iterdir()}
+
+
 def _carried(direction: str, topics: set[str]) -> Callable[[list[dict]], bool]:
     """Done once the link carries each of ``topics`` in ``direction`` ("out" or "in")."""
     return lambda events: topics <= {e["topic"] for e in events if e["event"] == "bridging"
@@ -136,6 +140,8 @@ def test_both_ways_without_loops_and_a_late_publisher(tmp_path: Path) -> None:
         links = [_link(a, f"--zenoh-listen {endpoint}", "--all"), _link(b, f"--zenoh-connect {endpoint}", "--all")]
         for link in links:
             _events_until(link, lambda events: all(_carried(way, {"/chatter"})(events) for way in ("out", "in")))
+        for link in links:  # Zenoh's receive work runs on its net runtime (zenoh_link.RUNTIME): no rx threads
+            assert "net-0" in _thread_names(link) and not any(n.startswith("rx-") for n in _thread_names(link))
         late = start_nodes([[{"name": "late", "publishers": [
             {"topic": "late_news", "type": "std_msgs/msg/String", "values": {"data": "new"}, "rate_hz": 10}]}]], b)
         _events_until(links[0], _carried("in", {"/late_news"}))

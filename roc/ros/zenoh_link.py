@@ -62,7 +62,8 @@ LATCHED_PREFIX = "roc/latched"
 ANNOUNCE_PREFIX = "roc/announce"
 # A link's socket is polled by Zenoh's net runtime and its messages decoded on the rx runtime, so
 # each message woke two threads; with rx handed over to net it wakes one (at 5 kHz the receiving
-# bridge's threads woke 1.6 times per message instead of 3.1, and the link added about 0.2 ms less).
+# bridge's threads woke 1.6 times per message instead of 3.1; over eight interleaved benchmark runs
+# the link added 0.2 ms less on average, though single runs vary by more).
 RUNTIME = "(rx: (handover: net))"
 IP_ENDPOINT = re.compile(r"(tcp|udp|tls|quic|ws)/(\[[0-9a-fA-F:.]+\]|[^/:?#\[\]]+):(\d{1,5})([?#].*)?")
 
