@@ -1,0 +1,8 @@
+"""The suite's processes stop on SIGINT (the tests' Ctrl+C) even when the suite was started with
+SIGINT ignored, as a shell does for a command it runs in the background (``bash scripts/test.sh &``):
+an ignored signal stays ignored in every child, a handled one is reset to its default."""
+
+import signal
+
+if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
