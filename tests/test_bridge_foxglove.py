@@ -63,8 +63,8 @@ class Bridge:
         """The first event (seen so far or to come within ``seconds``; only those that came after the
         event ``after``, if given) for which ``wanted`` is true."""
         deadline = time.monotonic() + seconds
+        start = 0 if after is None else next(i for i, e in enumerate(self.events) if e is after) + 1
         while True:
-            start = 0 if after is None else next(i for i, e in enumerate(self.events) if e is after) + 1
             found = next((e for e in self.events[start:] if wanted(e)), None)
             if found:
                 return found

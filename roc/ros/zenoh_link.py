@@ -19,7 +19,8 @@ No loops: the link forwards only topics with a publisher other than a bridge's (
 only republishes goes no further); the link's participant ignores its own endpoints (Fast DDS's
 BRIDGE_PROFILE, or the user's, checked by ``loop_guard``), so what it publishes never reaches its
 own subscriptions even when a topic has publishers on both sides; and its Zenoh subscribers take
-remote samples only, so a link never receives its own puts. The link never prints: ``run`` yields status events.
+remote samples only, so a link never receives its own puts. The link never prints: ``run`` yields
+status events.
 """
 
 from __future__ import annotations
