@@ -227,21 +227,27 @@ def test_the_bridges_writer_does_not_wake_fast_dds_for_each_message(tmp_path: Pa
                          b)
     bridge = _bridge("--from-domain", a["ROS_DOMAIN_ID"], "--to-domain", b["ROS_DOMAIN_ID"], "/fast",
                      "--format", "json", env=a)
+    deadline = time.monotonic() + 40
+
+    def bridged_per_second() -> float:
+        """The next rates event's count (messages a second, over about a second)."""
+        while (event := json.loads(_line(bridge, deadline)))["event"] != "rates":
+            pass
+        return sum(event["rates"].values())
     try:
         _events_until(bridge, "/fast")
-        deadline = time.monotonic() + 30
-        while True:  # the listener has matched the bridge's publisher once messages flow
-            event = json.loads(_line(bridge, deadline))
-            if event["event"] == "rates" and sum(event["rates"].values()) > 100:
-                break
-        wakes, bridged = _event_thread_wakes(bridge), 0
-        for _ in range(3):
-            while (event := json.loads(_line(bridge, deadline)))["event"] != "rates":
-                pass
-            bridged += sum(event["rates"].values())  # messages a second, over about a second
+        while bridged_per_second() < 100:  # messages flow
+            pass
+        info = json.loads(roc("topic", "info", "-v", "/fast", "--format", "json", "--no-daemon", env=b).stdout)
+        assert [s["node_name"] for s in info["subscribers"]] == ["listener"]  # else the writer sends to no one
+        while not bridge.lines.empty():  # printed while topic info ran
+            bridge.lines.get()
+        bridged_per_second()  # the count starts with a rates period
+        wakes = _event_thread_wakes(bridge)
+        bridged = sum(bridged_per_second() for _ in range(3))
         wakes = _event_thread_wakes(bridge) - wakes
-        assert bridged > 300, event
-        assert wakes < 0.5 * bridged, (wakes, bridged)
+        assert bridged > 300
+        assert wakes < bridged, (wakes, bridged)  # 2.6 a message with Fast DDS's default, 0.4 with roc's
     finally:
         assert _stop(bridge) == 130
         stop_all(nodes)
