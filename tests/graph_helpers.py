@@ -75,6 +75,11 @@ def read_line(process: subprocess.Popen, timeout: float = 20.0) -> str | None:
         return None
 
 
+def threads(process: subprocess.Popen) -> list[tuple[str, Path]]:
+    """Each thread of ``process`` (Linux): its name and its /proc task directory."""
+    return [(task.joinpath("comm").read_text().strip(), task) for task in Path(f"/proc/{process.pid}/task").iterdir()]
+
+
 def stop_all(processes: list[subprocess.Popen]) -> None:
     for process in processes:
         stop_process(process)

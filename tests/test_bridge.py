@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 from build_helpers import BIN, ros_domain_id, stop_process
-from graph_helpers import assert_call_and_goal_work, graph_env, roc, start_nodes, stop_all
+from graph_helpers import assert_call_and_goal_work, graph_env, roc, start_nodes, stop_all, threads
 
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("busy_or_timing")]  # see scripts/test.sh
 
@@ -207,12 +207,8 @@ def test_a_service_and_an_action_are_served_in_the_other_domain(tmp_path: Path) 
 
 def _event_thread_wakes(process: subprocess.Popen) -> int:
     """How many times the Fast DDS event threads (``dds.ev.N``, one per participant) of ``process`` slept."""
-    wakes = 0
-    for task in Path(f"/proc/{process.pid}/task").iterdir():
-        if task.joinpath("comm").read_text().startswith("dds.ev"):
-            status = task.joinpath("status").read_text()
-            wakes += int(status.split("voluntary_ctxt_switches:")[1].split()[0])
-    return wakes
+    return sum(int(task.joinpath("status").read_text().split("voluntary_ctxt_switches:")[1].split()[0])
+               for name, task in threads(process) if name.startswith("dds.ev"))
 
 
 def test_the_bridges_writer_does_not_wake_fast_dds_for_each_message(tmp_path: Path) -> None:

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 from build_helpers import ros_domain_id
-from graph_helpers import assert_call_and_goal_work, graph_env, roc, start_nodes, stop_all
+from graph_helpers import assert_call_and_goal_work, graph_env, roc, start_nodes, stop_all, threads
 from test_bridge import _bridge, _line, _stop, _talker_and_listener
 
 pytestmark = pytest.mark.xdist_group("busy_or_timing")  # see scripts/test.sh
@@ -52,10 +52,6 @@ def _events_until(process: subprocess.Popen, done: Callable[[list[dict]], bool],
         assert time.monotonic() < deadline, events
         events.append(json.loads(_line(process, deadline)))
     return events
-
-
-def _thread_names(process: subprocess.Popen) -> set[str]:
-    return {task.joinpath("comm").read_text().strip() for task in Path(f"/proc/{process.pid}/task").iterdir()}
 
 
 def _carried(direction: str, topics: set[str]) -> Callable[[list[dict]], bool]:
@@ -140,7 +136,8 @@ def test_both_ways_without_loops_and_a_late_publisher(tmp_path: Path) -> None:
         links = [_link(a, f"--zenoh-listen {endpoint}", "--all"), _link(b, f"--zenoh-connect {endpoint}", "--all")]
         for link in links:
             _events_until(link, lambda events: all(_carried(way, {"/chatter"})(events) for way in ("out", "in")))
-        for names in map(_thread_names, links):  # Zenoh's receive work runs on its net runtime: no rx threads
+        for link in links:  # Zenoh's receive work runs on its net runtime: no rx threads
+            names = {name for name, _ in threads(link)}
             assert "net-0" in names and not any(name.startswith("rx-") for name in names)
         late = start_nodes([[{"name": "late", "publishers": [
             {"topic": "late_news", "type": "std_msgs/msg/String", "values": {"data": "new"}, "rate_hz": 10}]}]], b)
