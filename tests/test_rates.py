@@ -42,6 +42,17 @@ def test_interleaved_publishers_fall_back_to_counting() -> None:
     assert window.rate()["rate"] == pytest.approx(3 / 0.15)
 
 
+def test_a_history_arriving_after_newer_messages_neither_reverses_nor_inflates_the_rate() -> None:
+    window = Window(10)  # a live publisher at 10 Hz, then another's transient local history (older)
+    window.add([_sample(100, 1000), _sample(101, 1100), _sample(102, 1200), _sample(1, 700), _sample(2, 800)])
+    rate = window.rate()
+    assert rate["rate"] == pytest.approx(4 / 0.5)
+    assert (rate["min"], rate["max"]) == (pytest.approx(0.1), pytest.approx(0.2))  # none negative
+    window = Window(10)  # the history first: the sequence numbers rise, but from two publishers
+    window.add([_sample(5, 0), _sample(6, 100), _sample(1000, 50), _sample(1001, 150)])
+    assert window.rate()["rate"] == pytest.approx(3 / 0.15)
+
+
 def test_bandwidth_and_delay() -> None:
     window = Window(10)
     window.add([_sample(n, n * 100, size=size, stamp_ms=n * 100 - 2) for n, size in ((1, 100), (2, 300), (3, 200))])

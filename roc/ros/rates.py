@@ -7,6 +7,7 @@ subscriber lost or received late do not change it (with ``wall_time``, reception
 
 from __future__ import annotations
 
+import itertools
 import statistics
 from collections import deque
 from dataclasses import dataclass
@@ -44,17 +45,21 @@ class Window:
             self.samples.append(sample)
 
     def rate(self, wall_time: bool = False) -> dict | None:
-        """``{rate, min, max, std_dev, window}`` (seconds between messages), or None before two samples."""
-        timed = [(s.sequence, s.received if wall_time or s.source is None else s.source) for s in self.samples]
-        if len(timed) < 2 or timed[-1][1] == timed[0][1]:
+        """``{rate, min, max, std_dev, window}`` (seconds between messages), or None before two samples.
+        Sequence numbers or source timestamps that do not rise in arrival order come from several
+        publishers: the messages are then counted, and their times sorted, since one publisher's
+        message can arrive after another's newer one (a transient local topic's history comes after
+        live messages)."""
+        times = sorted(s.received if wall_time or s.source is None else s.source for s in self.samples)
+        if len(times) < 2 or times[-1] == times[0]:
             return None
-        counted = all(sequence is not None for sequence, _ in timed)
-        messages = timed[-1][0] - timed[0][0] if counted else len(timed) - 1
-        if messages <= 0:  # several publishers: their sequence numbers interleave
-            messages = len(timed) - 1
-        deltas = [(b[1] - a[1]) * NS for a, b in zip(timed, timed[1:])]
-        return {"rate": messages / ((timed[-1][1] - timed[0][1]) * NS), "min": min(deltas), "max": max(deltas),
-                "std_dev": statistics.pstdev(deltas), "window": len(timed)}
+        first, last = self.samples[0], self.samples[-1]
+        one_publisher = all(a.sequence is not None and b.sequence is not None and a.sequence < b.sequence
+                            and (a.source or 0) <= (b.source or 0) for a, b in itertools.pairwise(self.samples))
+        messages = last.sequence - first.sequence if one_publisher else len(times) - 1
+        deltas = [(b - a) * NS for a, b in itertools.pairwise(times)]
+        return {"rate": messages / ((times[-1] - times[0]) * NS), "min": min(deltas), "max": max(deltas),
+                "std_dev": statistics.pstdev(deltas), "window": len(times)}
 
     def bandwidth(self) -> dict | None:
         """``{bytes_per_second, messages, mean, min, max}`` (sizes in bytes), or None before two samples."""
