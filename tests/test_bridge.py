@@ -3,16 +3,14 @@
 from __future__ import annotations
 
 import json
-import queue
 import signal
 import subprocess
-import threading
 import time
 from pathlib import Path
 
 import pytest
 from build_helpers import BIN, ros_domain_id, stop_process
-from graph_helpers import assert_call_and_goal_work, graph_env, roc, start_nodes, stop_all, threads
+from graph_helpers import assert_call_and_goal_work, graph_env, read_line, roc, start_nodes, stop_all, threads
 
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("busy_or_timing")]  # see scripts/test.sh
 
@@ -34,19 +32,17 @@ def domains(tmp_path):
 
 
 def _bridge(*args: str, env: dict[str, str]) -> subprocess.Popen:
-    """A running ``roc bridge``; its stdout lines go to ``.lines`` (a queue), so no read can hang."""
-    process = subprocess.Popen([str(BIN / "roc"), "bridge", *args], env=env, stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True)
-    process.lines = queue.SimpleQueue()
-    threading.Thread(target=lambda: [process.lines.put(line) for line in process.stdout], daemon=True).start()
-    return process
+    """A running ``roc bridge``; read its stdout with ``_line``."""
+    return subprocess.Popen([str(BIN / "roc"), "bridge", *args], env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
 
 
 def _line(process: subprocess.Popen, deadline: float) -> str:
-    try:
-        return process.lines.get(timeout=max(0.1, deadline - time.monotonic()))
-    except queue.Empty:
-        raise AssertionError("roc bridge printed nothing more in time") from None
+    """The bridge's next stdout line; fails the test if none comes before ``deadline``."""
+    line = read_line(process, deadline - time.monotonic())
+    if not line:
+        raise AssertionError("roc bridge ended" if line == "" else "roc bridge printed nothing more in time")
+    return line
 
 
 def _bridging_lines(process: subprocess.Popen, count: int, seconds: float = 20) -> list[str]:
@@ -157,6 +153,32 @@ def _talker_and_listener(side: str) -> dict:
             "subscribers": [{"topic": "chatter", "type": HEADER, "print": True}]}
 
 
+def _hear_the_other_side(nodes: list[subprocess.Popen], seconds: float = 30) -> list[list[str]]:
+    """The messages each ``_talker_and_listener`` node ("a", then "b") printed, read until each has
+    more than 20 from the other side's talker (a node may match the bridge's writer seconds late)."""
+    deadline = time.monotonic() + seconds
+    heard: list[list[str]] = []
+    for node, side, other in zip(nodes, ("a", "b"), ("b", "a")):
+        messages: list[str] = []
+        while sum(f"frame_id='{other}'" in message for message in messages) <= 20:
+            line = read_line(node, deadline - time.monotonic())
+            assert line, f"side {side} got {len(messages)} messages in {seconds} s, too few from side {other}"
+            if line.startswith("{"):
+                messages.append(line)
+        heard.append(messages)
+    return heard
+
+
+def _assert_each_arrived_once(nodes: list[subprocess.Popen], heard: list[list[str]]) -> None:
+    """With the nodes stopped, the rest of what they printed: no message arrived twice (a loop would
+    bring each one back again and again)."""
+    for node, messages in zip(nodes, heard):
+        while line := read_line(node, 10):
+            if line.startswith("{"):
+                messages.append(line)
+        assert len(messages) == len(set(messages)), "a message arrived twice"
+
+
 def test_both_ways_without_loops(tmp_path: Path) -> None:
     """/chatter bridged both ways between two domains, each with a talker: every message reaches the
     other domain once, and nothing the bridge publishes comes back to it."""
@@ -177,14 +199,11 @@ def test_both_ways_without_loops(tmp_path: Path) -> None:
             if event["event"] == "rates" and len(event["rates"]) == 2 and min(event["rates"].values()) > 5:
                 break
         assert max(event["rates"].values()) < 40, event
-        time.sleep(2)
+        heard = _hear_the_other_side(nodes)
     finally:
         assert _stop(bridge) == 130
         stop_all(nodes)
-    for process, other in zip(nodes, ("b", "a")):
-        received = [line for line in process.stdout.read().splitlines() if line.startswith("{")]
-        assert len(received) == len(set(received)), "a message arrived twice"
-        assert sum(f"frame_id='{other}'" in line for line in received) > 20
+    _assert_each_arrived_once(nodes, heard)
 
 
 def test_a_service_and_an_action_are_served_in_the_other_domain(tmp_path: Path) -> None:
@@ -236,8 +255,8 @@ def test_the_bridges_writer_does_not_wake_fast_dds_for_each_message(tmp_path: Pa
             pass
         info = json.loads(roc("topic", "info", "-v", "/fast", "--format", "json", "--no-daemon", env=b).stdout)
         assert [s["node_name"] for s in info["subscribers"]] == ["listener"]  # else the writer sends to no one
-        while not bridge.lines.empty():  # printed while topic info ran
-            bridge.lines.get()
+        while read_line(bridge, 0):  # printed while topic info ran
+            pass
         bridged_per_second()  # the count starts with a rates period
         wakes = _event_thread_wakes(bridge)
         bridged = sum(bridged_per_second() for _ in range(3))

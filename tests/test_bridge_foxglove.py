@@ -5,18 +5,16 @@ from __future__ import annotations
 
 import asyncio
 import json
-import queue
 import signal
 import socket
 import struct
 import subprocess
-import threading
 import time
 from pathlib import Path
 
 import pytest
 from build_helpers import BIN, stop_process
-from graph_helpers import graph_env, roc, start_nodes, stop_all
+from graph_helpers import graph_env, read_line, roc, start_nodes, stop_all
 from websockets.sync.client import connect
 
 from roc.ros.foxglove_server import SEPARATOR, _Session, schema_text
@@ -34,13 +32,6 @@ TALKER = {"name": "talker", "publishers": [
                     {"topic": "from_cdr", "type": "geometry_msgs/msg/Twist", "print": True}]}
 
 
-def _lines(process: subprocess.Popen) -> queue.SimpleQueue:
-    """The process's stdout lines, read on a thread into a queue (so that no read can hang)."""
-    lines = queue.SimpleQueue()
-    threading.Thread(target=lambda: [lines.put(line) for line in process.stdout], daemon=True).start()
-    return lines
-
-
 def _free_port() -> int:
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))
@@ -55,7 +46,6 @@ class Bridge:
         self.process = subprocess.Popen([str(BIN / "roc"), "bridge", "--foxglove", "--port", str(self.port),
                                          "--format", "json", *args], env=env, stdout=subprocess.PIPE,
                                         stderr=subprocess.PIPE, text=True)
-        self.lines = _lines(self.process)
         self.events: list[dict] = []
         self.event(lambda e: e["event"] == "serving")
 
@@ -68,15 +58,14 @@ class Bridge:
             found = next((e for e in self.events[start:] if wanted(e)), None)
             if found:
                 return found
-            try:
-                self.events.append(json.loads(self.lines.get(timeout=max(0.1, deadline - time.monotonic()))))
-            except queue.Empty:
-                raise AssertionError(f"no such event in {seconds} s; got {self.events}") from None
+            line = read_line(self.process, deadline - time.monotonic())
+            assert line, f"no such event in {seconds} s; got {self.events}"
+            self.events.append(json.loads(line))
 
     def drain(self) -> list[dict]:
         """Every event so far."""
-        while not self.lines.empty():
-            self.events.append(json.loads(self.lines.get()))
+        while line := read_line(self.process, 0):
+            self.events.append(json.loads(line))
         return self.events
 
     def stop(self) -> int:
@@ -142,7 +131,6 @@ class Client:
 def talker_env(tmp_path):
     env = graph_env(140, tmp_path)
     talker = start_nodes([[TALKER]], env)
-    talker[0].lines = _lines(talker[0])
     yield env, talker[0]
     stop_all(talker)
 
@@ -221,12 +209,9 @@ def test_client_publishing_reaches_a_ros_subscriber(bridge: Bridge, talker_env) 
             assert time.monotonic() < deadline, (received, bridge.events)
             client.send(7, json.dumps({"data": "hello"}).encode())
             client.send(8, twist)
-            try:
-                while True:
-                    line = json.loads(talker.lines.get(timeout=0.3))
-                    received[line["topic"]] = line["message"]
-            except queue.Empty:
-                pass
+            while line := read_line(talker, 0.3):
+                message = json.loads(line)
+                received[message["topic"]] = message["message"]
         assert received == wanted
         cdr = bridge.event(lambda e: e["event"] == "client_advertised" and e["topic"] == "/from_cdr")
         assert cdr["encoding"] == "cdr"

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 from build_helpers import ros_domain_id
 from graph_helpers import assert_call_and_goal_work, graph_env, roc, start_nodes, stop_all, threads
-from test_bridge import _bridge, _line, _stop, _talker_and_listener
+from test_bridge import _assert_each_arrived_once, _bridge, _hear_the_other_side, _line, _stop, _talker_and_listener
 
 pytestmark = pytest.mark.xdist_group("busy_or_timing")  # see scripts/test.sh
 
@@ -150,14 +150,12 @@ def test_both_ways_without_loops_and_a_late_publisher(tmp_path: Path) -> None:
             if min(rates.get(f"/chatter ({way})", 0) for way in ("in", "out")) > 5:
                 break
         assert max(rates.values()) < 40, event
+        heard = _hear_the_other_side(nodes)
         assert [_stop(link) for link in links] == [130, 130]
     finally:
         stop_all([*links, *late])
         stop_all(nodes)
-    for process, other in zip(nodes, ("b", "a")):
-        received = [line for line in process.stdout.read().splitlines() if line.startswith("{")]
-        assert len(received) == len(set(received)), "a message arrived twice"
-        assert sum(f"frame_id='{other}'" in line for line in received) > 20
+    _assert_each_arrived_once(nodes, heard)
 
 
 def _certificates(directory: Path) -> dict[str, Path]:
