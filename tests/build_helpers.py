@@ -73,10 +73,26 @@ def package_dsv_files(install: Path) -> dict[str, str]:
     return {str(p.relative_to(install)): p.read_text() for p in install.rglob("package.dsv")}
 
 
-def ros_domain_id(base: int) -> str:
-    """A ROS domain of its own for each pytest-xdist worker, so tests never see each other's nodes."""
-    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
-    return str(base + int(worker.removeprefix("gw") or 0))
+# Each test file that starts ROS participants has a slot of its own; a slot is one ROS domain per
+# pytest-xdist worker, counted from ROC_TEST_DOMAIN_BASE (default 20). Two test runs on one machine (two
+# checkouts, or a person beside a robot on domain 20) stay apart with, e.g., ROC_TEST_DOMAIN_BASE=120.
+DOMAIN_SLOTS = 40
+DOMAIN_MAX = 232  # Fast DDS's highest domain id (its UDP ports are derived from it)
+
+
+def ros_domain_id(slot: int) -> str:
+    """The ROS domain of ``slot`` (0 .. DOMAIN_SLOTS - 1) for this pytest-xdist worker."""
+    assert 0 <= slot < DOMAIN_SLOTS, f"domain slot {slot}: raise DOMAIN_SLOTS in tests/build_helpers.py"
+    workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    worker = int(os.environ.get("PYTEST_XDIST_WORKER", "gw0").removeprefix("gw") or 0)
+    base = os.environ.get("ROC_TEST_DOMAIN_BASE", "20")
+    if not base.isdigit():
+        raise ValueError(f"ROC_TEST_DOMAIN_BASE={base!r}: expected a ROS domain id such as 20")
+    domain = int(base) + slot * workers + worker
+    if domain > DOMAIN_MAX:
+        raise ValueError(f"ROC_TEST_DOMAIN_BASE={base}: this run needs domains up to "
+                         f"{int(base) + DOMAIN_SLOTS * workers - 1}, above {DOMAIN_MAX}; choose a lower base")
+    return str(domain)
 
 
 def stop_process(process: subprocess.Popen) -> None:

@@ -33,11 +33,12 @@ DEMO_GRAPH = [
 ]
 
 
-def graph_env(base: int, runtime_dir: Path, **extra: str) -> dict[str, str]:
-    """A private ROS domain, localhost discovery and a private daemon directory."""
+def graph_env(slot: int, runtime_dir: Path, **extra: str) -> dict[str, str]:
+    """A private ROS domain (the test file's slot, see build_helpers.ros_domain_id), localhost discovery
+    and a private daemon directory."""
     env = dict(os.environ)
     env.pop("ROS_LOCALHOST_ONLY", None)
-    env.update(ROS_DOMAIN_ID=ros_domain_id(base), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
+    env.update(ROS_DOMAIN_ID=ros_domain_id(slot), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
                XDG_RUNTIME_DIR=str(runtime_dir), AMENT_PREFIX_PATH=f"{ORACLE_VENV}{os.pathsep}{sys.prefix}",
                PATH=f"{BIN}{os.pathsep}{env.get('PATH', '/usr/bin:/bin')}")
     env.update(extra)

@@ -17,9 +17,9 @@ import sys
 import time
 
 import rclpy
-from rclpy.duration import Duration
 from rclpy.action import CancelResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.duration import Duration
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy

@@ -24,8 +24,8 @@ TALKER = {"name": "talker", "publishers": [
 @pytest.fixture
 def domains(tmp_path):
     """Two ROS domains of this worker's own (A with a talker), and an environment for each."""
-    a = graph_env(100, tmp_path / "a")
-    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(110)}
+    a = graph_env(10, tmp_path / "a")
+    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(11)}
     processes = start_nodes([[TALKER]], a)
     yield a, b
     stop_all(processes)
@@ -138,7 +138,7 @@ def test_bad_bridges_are_one_line(tmp_path: Path, args: list[str], config: str |
     if config is not None:
         (tmp_path / "bridge.yaml").write_text(config)
         args = [*args, "--config", str(tmp_path / "bridge.yaml")]
-    result = roc("bridge", *args, env=graph_env(100, tmp_path))
+    result = roc("bridge", *args, env=graph_env(10, tmp_path))
     assert result.returncode == 2 and error in result.stderr.splitlines()[0], result.stderr
 
 
@@ -182,8 +182,8 @@ def _assert_each_arrived_once(nodes: list[subprocess.Popen], heard: list[list[st
 def test_both_ways_without_loops(tmp_path: Path) -> None:
     """/chatter bridged both ways between two domains, each with a talker: every message reaches the
     other domain once, and nothing the bridge publishes comes back to it."""
-    a = graph_env(100, tmp_path / "a")
-    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(110)}
+    a = graph_env(10, tmp_path / "a")
+    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(11)}
     nodes = start_nodes([[_talker_and_listener("a")]], a) + start_nodes([[_talker_and_listener("b")]], b)
     bridge = _bridge("--from-domain", a["ROS_DOMAIN_ID"], "--to-domain", b["ROS_DOMAIN_ID"], "--bidirectional",
                      "/chatter", "--format", "json", env=a)
@@ -207,8 +207,8 @@ def test_both_ways_without_loops(tmp_path: Path) -> None:
 
 
 def test_a_service_and_an_action_are_served_in_the_other_domain(tmp_path: Path) -> None:
-    a = graph_env(100, tmp_path / "a")
-    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(110)}
+    a = graph_env(10, tmp_path / "a")
+    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(11)}
     server = start_nodes([[{"name": "server", "services": [
         {"name": "echo_types", "type": "test_msgs/srv/BasicTypes", "echo": True}],
         "actions": [{"name": "fibonacci", "step_seconds": 0.05}]}]], a)
@@ -234,8 +234,8 @@ def test_the_bridges_writer_does_not_wake_fast_dds_for_each_message(tmp_path: Pa
     """A reliable writer with Fast DDS's default NACK suppression (0 s) wakes its participant's event
     thread more than twice per message sent to another process; the bridge's profile (20 ms) covers
     many messages with one timer."""
-    a = graph_env(100, tmp_path / "a")
-    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(110)}
+    a = graph_env(10, tmp_path / "a")
+    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(11)}
     nodes = start_nodes([[{"name": "fast_talker", "publishers": [
         {"topic": "fast", "type": "std_msgs/msg/String", "values": {"data": "x"}, "rate_hz": 500}]}]], a)
     nodes += start_nodes([[{"name": "listener", "subscribers": [{"topic": "fast", "type": "std_msgs/msg/String"}]}]],

@@ -129,7 +129,7 @@ class Client:
 
 @pytest.fixture
 def talker_env(tmp_path):
-    env = graph_env(140, tmp_path)
+    env = graph_env(14, tmp_path)
     talker = start_nodes([[TALKER]], env)
     yield env, talker[0]
     stop_all(talker)
@@ -280,7 +280,7 @@ def test_a_port_in_use_is_one_line(tmp_path: Path) -> None:
         taken.bind(("127.0.0.1", 0))
         taken.listen()
         port = taken.getsockname()[1]
-        result = roc("bridge", "--foxglove", "--port", str(port), env=graph_env(140, tmp_path))
+        result = roc("bridge", "--foxglove", "--port", str(port), env=graph_env(14, tmp_path))
     assert result.returncode == 1 and result.stderr.splitlines() == [
         f"roc: error: port {port} on 127.0.0.1 is in use: stop what listens there or choose another with --port"]
 
@@ -292,7 +292,7 @@ def test_a_port_in_use_is_one_line(tmp_path: Path) -> None:
     (["--include", "("], "--include/--exclude: invalid regular expression '('"),
 ])
 def test_bad_foxglove_options_are_one_line(tmp_path: Path, args: list[str], error: str) -> None:
-    result = roc("bridge", "--foxglove", *args, env=graph_env(140, tmp_path))
+    result = roc("bridge", "--foxglove", *args, env=graph_env(14, tmp_path))
     assert result.returncode == 2 and error in result.stderr.splitlines()[0], result.stderr
 
 

@@ -81,8 +81,8 @@ def _first_messages(process: subprocess.Popen, seconds: float = 40) -> dict[str,
 
 @pytest.mark.slow
 def test_topics_arrive_intact_with_their_names_types_and_qos_and_a_service_and_an_action_answer(tmp_path: Path) -> None:
-    a = graph_env(120, tmp_path / "a")
-    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(125)}
+    a = graph_env(12, tmp_path / "a")
+    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(13)}
     endpoint = f"tcp/127.0.0.1:{_free_port()}"
     talker = start_nodes([[{"name": "talker", "publishers": [
         {"topic": topic, "type": type_name, "values": values, **qos, **({} if topic == "latched" else {"rate_hz": 10})}
@@ -127,8 +127,8 @@ def test_topics_arrive_intact_with_their_names_types_and_qos_and_a_service_and_a
 def test_both_ways_without_loops_and_a_late_publisher(tmp_path: Path) -> None:
     """Both links carry every topic; /chatter has a talker on each side: every message reaches the
     other side once and nothing comes back; a publisher started later on side B reaches side A."""
-    a = graph_env(120, tmp_path / "a")
-    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(125)}
+    a = graph_env(12, tmp_path / "a")
+    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(13)}
     endpoint = f"tcp/127.0.0.1:{_free_port()}"
     nodes = start_nodes([[_talker_and_listener("a")]], a) + start_nodes([[_talker_and_listener("b")]], b)
     links, late = [], []
@@ -175,8 +175,8 @@ def _certificates(directory: Path) -> dict[str, Path]:
 @pytest.mark.slow
 @pytest.mark.skipif(shutil.which("openssl") is None, reason="openssl makes the test certificates")
 def test_tls_as_zenoh_configures_it(tmp_path: Path) -> None:
-    a = graph_env(120, tmp_path / "a")
-    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(125)}
+    a = graph_env(12, tmp_path / "a")
+    b = {**a, "ROS_DOMAIN_ID": ros_domain_id(13)}
     files = _certificates(tmp_path)
     listen, connect = tmp_path / "listen.json5", tmp_path / "connect.json5"
     no_scouting = "scouting: {multicast: {enabled: false}}"
@@ -206,7 +206,7 @@ def test_tls_as_zenoh_configures_it(tmp_path: Path) -> None:
     (["--zenoh-listen", "tcp/127.0.0.1:7447", "--domain", "300", "--all"], "--domain: expected a ROS domain id"),
 ])
 def test_bad_zenoh_bridges_are_one_line(tmp_path: Path, args: list[str], error: str) -> None:
-    result = roc("bridge", *args, env=graph_env(120, tmp_path))
+    result = roc("bridge", *args, env=graph_env(12, tmp_path))
     assert result.returncode == 2 and error in result.stderr.splitlines()[0], result.stderr
 
 
@@ -215,7 +215,7 @@ def test_a_busy_listen_port_is_one_line(tmp_path: Path) -> None:
         busy.bind(("127.0.0.1", 0))
         busy.listen()
         endpoint = f"tcp/127.0.0.1:{busy.getsockname()[1]}"
-        result = roc("bridge", "--zenoh-listen", endpoint, "--all", env=graph_env(120, tmp_path))
+        result = roc("bridge", "--zenoh-listen", endpoint, "--all", env=graph_env(12, tmp_path))
     assert result.returncode == 2, result.stderr
     assert result.stderr.startswith(f"roc: error: cannot open the Zenoh session: Can not create a new TCP listener "
                                     f"bound to {endpoint}"), result.stderr

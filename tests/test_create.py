@@ -71,7 +71,7 @@ def build(ws: Path) -> None:
 
 
 def sourced(ws: Path, script: str, strict: bool = True) -> str:
-    ran = in_sourced_shell(ws, f"export ROS_DOMAIN_ID={ros_domain_id(70)}; {script}", strict=strict)
+    ran = in_sourced_shell(ws, f"export ROS_DOMAIN_ID={ros_domain_id(7)}; {script}", strict=strict)
     assert ran.returncode == 0, ran.stdout + ran.stderr
     return ran.stdout
 
@@ -164,7 +164,7 @@ def test_python_node_publishes_on_the_ros_graph(tmp_path):
                         "-p period:=0.05 2>&1")
     assert re.findall(r"Publishing '(.*)'", alone) == ["Hello, talker! 1", "Hello, talker! 2", "Hello, talker! 3"]
     # A listener in another process receives its messages.
-    env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin", "ROS_DOMAIN_ID": ros_domain_id(70),
+    env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin", "ROS_DOMAIN_ID": ros_domain_id(7),
            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST", "RMW_IMPLEMENTATION": "rmw_fastrtps_cpp"}
     listener_code = (
         "import time, rclpy\nfrom rclpy.node import Node\nfrom std_msgs.msg import String\n"
@@ -455,7 +455,7 @@ def test_maintainer_defaults_come_from_git_config(tmp_path):
 def test_help_documents_every_option(tmp_path):
     import argparse
 
-    from roc.commands import work_create
+    from roc.commands.work import create as work_create
 
     parser = argparse.ArgumentParser()
     work_create.add_arguments(parser)

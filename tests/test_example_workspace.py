@@ -52,7 +52,7 @@ def test_powershell_scripts(example):
 
 
 def test_python_node_messages_arrive(example):
-    env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin", "ROS_DOMAIN_ID": ros_domain_id(60),
+    env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin", "ROS_DOMAIN_ID": ros_domain_id(5),
            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST", "RMW_IMPLEMENTATION": "rmw_fastrtps_cpp"}
     source = "set -eu; source install/setup.bash; exec "
     listener = subprocess.Popen(["bash", "-c", source + "install/demo_py/lib/demo_py/reading_listener "
@@ -74,7 +74,7 @@ def test_python_node_messages_arrive(example):
 
 def test_frame_verbs_work_in_the_sourced_example(example):
     """The example's tf2_msgs is what roc frame needs: a static transform published and looked up."""
-    env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin", "ROS_DOMAIN_ID": ros_domain_id(60),
+    env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin", "ROS_DOMAIN_ID": ros_domain_id(5),
            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST", "RMW_IMPLEMENTATION": "rmw_fastrtps_cpp"}
     source = "set -eu; source install/setup.bash; exec "
     pub = subprocess.Popen(["bash", "-c", source + "roc frame pub map odom --x 1 --yaw 90 --degrees --no-daemon"], cwd=example,

@@ -28,7 +28,7 @@ def sourced(tmp_path_factory):
     shutil.copytree(REPO / "workspaces" / "example" / "src" / "tf2_msgs", workspace / "src" / "tf2_msgs")
     built = roc("work", "build", cwd=workspace)
     assert built.returncode == 0, built.stdout + built.stderr
-    env = graph_env(65, tmp_path_factory.mktemp("runtime"))
+    env = graph_env(6, tmp_path_factory.mktemp("runtime"))
     dumped = subprocess.run(["bash", "-c", f'source "{workspace}/install/setup.bash" && env -0'], env=env,
                             capture_output=True, timeout=60)
     assert dumped.returncode == 0, dumped.stderr
@@ -152,7 +152,7 @@ def test_pub_reaches_a_real_subscriber_and_ctrl_c_stops_it(sourced) -> None:
 
 
 def test_without_tf2_msgs_every_frame_verb_says_what_to_do(tmp_path: Path) -> None:
-    env = graph_env(65, tmp_path)
+    env = graph_env(6, tmp_path)
     env = {k: v for k, v in env.items() if k != "PYTHONPATH"} | {"AMENT_PREFIX_PATH": os.environ.get("VIRTUAL_ENV", sys.prefix)}
     for verb in (["list"], ["echo", "a", "b"], ["tree"], ["monitor"], ["pub", "a", "b"]):
         result = frame(*verb, env=env)

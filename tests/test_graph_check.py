@@ -71,7 +71,7 @@ VIOLATIONS = {
 
 @pytest.fixture(scope="module")
 def graph(tmp_path_factory):
-    env = graph_env(85, tmp_path_factory.mktemp("runtime"))
+    env = graph_env(9, tmp_path_factory.mktemp("runtime"))
     processes = start_nodes(SYSTEM, env)
     yield env
     stop_daemon(env)

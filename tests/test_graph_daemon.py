@@ -14,7 +14,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
-
+from build_helpers import ros_domain_id
 from graph_helpers import BIN, graph_env, roc, start_nodes, stop_all, stop_daemon
 
 pytestmark = pytest.mark.slow
@@ -26,13 +26,13 @@ def status(env: dict[str, str]) -> dict:
 
 @pytest.fixture
 def talker(tmp_path):
-    env = graph_env(30, tmp_path / "runtime")
+    env = graph_env(1, tmp_path / "runtime")
     (tmp_path / "runtime").mkdir()
     processes = start_nodes([{"name": "talker", "publishers": [{"topic": "chatter", "type": "std_msgs/msg/String"}]}],
                             env)
     yield env
     stop_daemon(env)
-    stop_daemon({**env, "ROS_DOMAIN_ID": str(int(env["ROS_DOMAIN_ID"]) + 20)})
+    stop_daemon({**env, "ROS_DOMAIN_ID": ros_domain_id(17)})
     stop_all(processes)
 
 
@@ -49,7 +49,7 @@ def test_lifecycle(talker):
     assert roc("daemon", "status", env=env).stdout == "The daemon is running\n"
 
     # Another discovery environment gets its own daemon.
-    other = {**env, "ROS_DOMAIN_ID": str(int(env["ROS_DOMAIN_ID"]) + 20)}
+    other = {**env, "ROS_DOMAIN_ID": ros_domain_id(17)}
     assert "/chatter" not in roc("topic", "list", env=other).stdout.splitlines()
     assert status(other)["pid"] != first["pid"]
 
@@ -131,7 +131,7 @@ def test_bad_request_gets_an_error_line(talker):
 @pytest.mark.xdist_group("busy_or_timing")
 def test_no_daemon_is_complete(tmp_path):
     """Five processes, ten daemon-less runs: every node every time (ros2 misses some in most runs)."""
-    env = graph_env(40, tmp_path)
+    env = graph_env(2, tmp_path)
     specs = [{"name": f"node{i}", "publishers": [{"topic": f"topic{i}", "type": "std_msgs/msg/String"}]}
              for i in range(5)]
     processes = start_nodes(specs, env)
@@ -194,7 +194,7 @@ def test_a_long_running_daemon_hears_each_new_publisher_from_its_first_message(t
     until its next announcement (Fast DDS: every 3 s). Through a daemon that had run a while, echo
     started up to 3 s late on a new publisher, in about half the runs; roc's participants announce
     themselves every 0.5 s (roc/ros/fastdds_participant.xml)."""
-    env = graph_env(160, tmp_path)
+    env = graph_env(16, tmp_path)
     try:
         assert roc("daemon", "start", env=env).returncode == 0
         time.sleep(4)  # the daemon announces itself periodically by now

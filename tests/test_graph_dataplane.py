@@ -31,7 +31,7 @@ LISTENER = {"name": "listener", "subscribers": [
 
 @pytest.fixture(scope="module")
 def graph(tmp_path_factory):
-    env = graph_env(80, tmp_path_factory.mktemp("runtime"))
+    env = graph_env(8, tmp_path_factory.mktemp("runtime"))
     processes = start_nodes([[TALKER], [LISTENER, MOTOR]], env)
     yield env, processes[1]
     stop_daemon(env)

@@ -32,7 +32,7 @@ def graph(monkeypatch):
         calls.append((method, use_daemon, spin_time))
         return json.loads(json.dumps(SNAPSHOT))
 
-    monkeypatch.setattr("roc.commands.graph_common.query", fake_query)
+    monkeypatch.setattr("roc.commands.graph_query.query", fake_query)
 
     def run(capsys, *argv):
         code = main(list(argv))
@@ -115,7 +115,8 @@ class FakeConnection:
 
 def test_daemon_of_another_version_or_environment_is_shut_down():
     from roc import __version__
-    from roc.ros.client import _usable, discovery_environment
+    from roc.ros.client import _usable
+    from roc.ros.protocol import discovery_environment
 
     same = FakeConnection({"version": __version__, "environment": discovery_environment()})
     assert _usable(same) and same.sent == ["hello"] and not same.closed
@@ -162,7 +163,7 @@ def test_discovery_waits_for_a_quiet_graph_bounded_by_spin_time():
 
 def test_a_domain_bridge_config_keeps_repeated_topics_and_reverses(tmp_path: Path) -> None:
     """domain_bridge's own example names a topic several times; each entry is a route."""
-    from roc.commands.bridge import routes_from_config
+    from roc.commands.bridge.domains import routes_from_config
     from roc.ros.bridge import Route
 
     config = tmp_path / "bridge.yaml"

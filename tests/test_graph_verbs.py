@@ -6,7 +6,6 @@ import json
 import time
 
 import pytest
-
 from graph_helpers import DEMO_GRAPH, graph_env, install_oracle, roc, ros2, start_nodes, stop_all, stop_daemon
 
 pytestmark = pytest.mark.slow
@@ -21,7 +20,7 @@ def oracle():
 
 @pytest.fixture(scope="module")
 def demo(tmp_path_factory, oracle):
-    env = graph_env(20, tmp_path_factory.mktemp("runtime"))
+    env = graph_env(0, tmp_path_factory.mktemp("runtime"))
     processes = start_nodes(DEMO_GRAPH, env)
     ros2("daemon", "start", env=env)
     roc("daemon", "start", env=env)
@@ -148,7 +147,7 @@ def test_client_does_not_import_rclpy(demo):
 def test_qos_incompatibility_and_duplicate_names_flagged(tmp_path):
     from graph_helpers import start_nodes, stop_all
 
-    env = graph_env(45, tmp_path)
+    env = graph_env(3, tmp_path)
     processes = start_nodes([
         [{"name": "sensor", "publishers": [{"topic": "scan", "type": "std_msgs/msg/String",
                                             "reliability": "best_effort"}]}],

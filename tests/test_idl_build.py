@@ -6,7 +6,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-
 from build_helpers import in_sourced_shell, roc
 from idl_helpers import DATA
 

@@ -7,8 +7,8 @@ from __future__ import annotations
 import shutil
 
 import pytest
-
 from build_helpers import FIXTURES, colcon, in_sourced_shell
+
 from roc.idl.codegen import generate
 
 PACKAGE = FIXTURES / "idl" / "src" / "robot_proto_msgs"

@@ -5,9 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-
 from idl_helpers import write
-from roc.commands.idl_protobuf import convert
+
+from roc.commands.idl.protobuf import convert
 from roc.errors import RocError
 
 STATUS = """\

@@ -7,10 +7,10 @@ import sys
 from pathlib import Path
 
 import pytest
+from idl_helpers import DATA, check_msg_with_rosidl_parser, write
 from rosidl_adapter.parser import parse_message_string
 
-from idl_helpers import DATA, check_msg_with_rosidl_parser, write
-from roc.commands.idl_protobuf import convert
+from roc.commands.idl.protobuf import convert
 from roc.errors import RocError
 from roc.idl import msg_to_proto
 

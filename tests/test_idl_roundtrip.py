@@ -6,10 +6,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from idl_helpers import check_msg_with_rosidl_parser, interface_msgs, write
 from rosidl_adapter.parser import parse_message_file, parse_message_string
 
-from idl_helpers import check_msg_with_rosidl_parser, interface_msgs, write
-from roc.commands.idl_protobuf import convert
+from roc.commands.idl.protobuf import convert
 from roc.idl.msg_to_proto import SCALARS
 
 # The ROS type each ROS type comes back as (msg -> proto -> msg).

@@ -7,9 +7,9 @@ import importlib
 
 import pytest
 from google.protobuf import descriptor_pool, message_factory
-
 from idl_helpers import interface_msgs, write
-from roc.commands.idl_protobuf import convert
+
+from roc.commands.idl.protobuf import convert
 from roc.idl import protoc
 from roc.idl.runtime import to_proto, to_ros
 

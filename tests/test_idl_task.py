@@ -8,8 +8,8 @@ import shutil
 from pathlib import Path
 
 import pytest
-
 from build_helpers import FIXTURES, in_sourced_shell, roc
+
 from roc.engine.events import TaskOutput
 from roc.engine.process import TaskContext, TaskError
 from roc.idl.task import STATE_FILE, IdlGeneration, proto_directory

@@ -17,13 +17,23 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from build_helpers import REPO, in_sourced_shell, roc, ros_env
 from rclpy.serialization import deserialize_message, serialize_message
 from rosidl_parser import definition as idl
 
-from build_helpers import REPO, in_sourced_shell, roc, ros_env
 from roc.ros import messages
-from roc.ros.messages import (MessageValueError, dict_to_yaml, echo_text, fill_message, get_field, message_to_csv,
-                              message_to_dict, message_to_yaml, parse_values, prototype)
+from roc.ros.messages import (
+    MessageValueError,
+    dict_to_yaml,
+    echo_text,
+    fill_message,
+    get_field,
+    message_to_csv,
+    message_to_dict,
+    message_to_yaml,
+    parse_values,
+    prototype,
+)
 from roc.ros.types import UnknownTypeError, resolve_type, type_name
 
 SHARED = Path(__file__).resolve().parents[2] / "shared"

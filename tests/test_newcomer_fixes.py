@@ -4,16 +4,16 @@ from __future__ import annotations
 
 import io
 import json
+import os
 import shutil
 import subprocess
-import os
 import sys
 from pathlib import Path
 
 import pytest
 from build_helpers import copy_fixture, roc, ros_env
 
-from roc.engine.events import Tick, TaskOutput, TaskQueued, TaskStarted
+from roc.engine.events import TaskOutput, TaskQueued, TaskStarted, Tick
 
 
 class FakeLive:

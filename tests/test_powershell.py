@@ -18,7 +18,6 @@ from roc.environment.dsv import Operation
 from roc.shell.scripts import render
 
 
-
 def test_the_parser_finds_errors():
     """The checks below mean something only if the grammar rejects broken PowerShell."""
     for broken in ("if ($a { . $b }\n", "$x = 'unterminated\n", "function f { \n"):

@@ -76,7 +76,7 @@ graph.close()
 
 
 def test_receiver_takes_everything_and_echo_counts_losses_per_publisher(tmp_path: Path) -> None:
-    env = graph_env(150, tmp_path)
+    env = graph_env(15, tmp_path)
     result = subprocess.run([sys.executable, "-c", SCRIPT], env=env, capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr
     found = json.loads(result.stdout.splitlines()[-1])

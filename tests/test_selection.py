@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+from roc.cli.options import add_selection_arguments
 from roc.errors import UsageError
 from roc.workspace.dependencies import (
     DependencyCycleError,
@@ -15,7 +16,6 @@ from roc.workspace.dependencies import (
     topological_order,
 )
 from roc.workspace.package import Package
-from roc.cli.options import add_selection_arguments
 from roc.workspace.selection import (
     check_selection_arguments,
     ignore_packages,

@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-
 from build_helpers import roc
 
 MANIFEST = """<?xml version="1.0"?>

@@ -13,8 +13,7 @@ from pathlib import Path
 
 import psutil
 import pytest
-
-from build_helpers import BIN, colcon, copy_fixture, ros_env, roc
+from build_helpers import BIN, colcon, copy_fixture, roc, ros_env
 
 pytestmark = pytest.mark.slow
 FAILING = {"t_cmake_pytest", "t_plain", "t_py"}

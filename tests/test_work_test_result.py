@@ -5,9 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from lxml import etree
-
 from build_helpers import colcon, roc
+from lxml import etree
 
 GTEST = """<?xml version="1.0" encoding="UTF-8"?>
 <testsuites tests="3" failures="1" disabled="1" errors="0" name="AllTests">

@@ -38,10 +38,11 @@ Unknown keys and wrong value types are errors naming the file, line and key.
 from __future__ import annotations
 
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+import tomllib
 
 from roc.config import ROC_TOML, ConfigError
 from roc.errors import UsageError

@@ -14,7 +14,7 @@ from typing import Any
 from rclpy.serialization import deserialize_message
 
 from roc.ros.cdr import serialize
-from roc.ros.dataplane import HEARTBEAT_SECONDS
+from roc.ros.protocol import HEARTBEAT_SECONDS
 from roc.ros.types import action_class, service_class
 
 

@@ -13,28 +13,21 @@ import socket
 import sys
 import time
 import zlib
+from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 from roc import __version__
 from roc.errors import RocError
+from roc.ros.protocol import discovery_environment
 
-# The variables that decide what a participant discovers: a daemon serves one set of values.
-DISCOVERY_VARIABLES = ("ROS_DOMAIN_ID", "RMW_IMPLEMENTATION", "ROS_AUTOMATIC_DISCOVERY_RANGE",
-                       "ROS_STATIC_PEERS", "ROS_LOCALHOST_ONLY")
-DEFAULT_SPIN_TIME = 3.5  # daemon-less discovery (see roc.ros.graph)
 REQUEST_TIMEOUT = float(os.environ.get("ROC_DAEMON_TIMEOUT", "30"))
 START_TIMEOUT = 15.0
 
 
 class DaemonError(RocError):
     """The daemon answered with an error (its message is for the user)."""
-
-
-def discovery_environment(env: dict[str, str] | None = None) -> dict[str, str]:
-    env = os.environ if env is None else env
-    return {name: env.get(name, "") for name in DISCOVERY_VARIABLES}
 
 
 def daemon_key(env: dict[str, str] | None = None) -> str:
@@ -93,7 +86,7 @@ class Connection:
                 yield response
                 if response.get("final"):
                     return
-        except socket.timeout:
+        except TimeoutError:
             raise RocError(f"the roc daemon did not answer '{method}' within {timeout:g} s") from None
 
     def request(self, method: str, params: dict[str, Any] | None = None, timeout: float = REQUEST_TIMEOUT) -> Any:
@@ -215,9 +208,7 @@ def query(method: str, params: dict[str, Any] | None = None, *, use_daemon: bool
     """Answer a graph request, through the daemon unless ``use_daemon`` is false."""
     params = params or {}
     if not use_daemon:
-        from roc.ros.graph import local_query
-
-        return local_query(method, params, spin_time)
+        return _in_process().query(method, params, spin_time)
     connection = start_daemon()
     try:
         return connection.request(method, params)
@@ -228,14 +219,12 @@ def query(method: str, params: dict[str, Any] | None = None, *, use_daemon: bool
 def stream(method: str, params: dict[str, Any], *, use_daemon: bool = True, heartbeats: bool = False,
            **local: Any) -> Iterator[dict[str, Any]]:
     """The events of a streaming request (roc.ros.dataplane), in the daemon unless ``use_daemon`` is
-    false (``local``: options of roc.ros.dataplane.local_stream), or in this process when the daemon
+    false (``local``: options of roc.ros.in_process.stream), or in this process when the daemon
     cannot import the type; closing the iterator (or Ctrl+C) ends the stream and removes its endpoint.
     ``heartbeats``: pass on the heartbeat events too (at least every 0.5 s, to act between events)."""
     skipped = () if heartbeats else ("heartbeat",)
     if not use_daemon:
-        from roc.ros.streams import local_stream
-
-        events = local_stream(method, params, **local)
+        events = _in_process().stream(method, params, **local)
         yield from (event for event in events if event.get("event") not in skipped)
         return
     connection = start_daemon()
@@ -267,10 +256,7 @@ class Session:
         if use_daemon:
             start_daemon().close()
         else:
-            from roc.ros.graph import Graph
-
-            self.graph = Graph()
-            self.graph.wait_for_discovery(spin_time if spin_time is not None else DEFAULT_SPIN_TIME)
+            self.graph = _in_process().discovered_graph(spin_time)
 
     def query(self, method: str, params: dict[str, Any] | None = None) -> Any:
         if self.graph is not None:
@@ -281,10 +267,17 @@ class Session:
         if self.graph is None:
             yield from stream(method, params, heartbeats=heartbeats)
             return
-        from roc.ros.streams import run_on
-
-        yield from (e for e in run_on(self.graph, method, params) if heartbeats or e.get("event") != "heartbeat")
+        events = _in_process().stream_on(self.graph, method, params)
+        yield from (e for e in events if heartbeats or e.get("event") != "heartbeat")
 
     def close(self) -> None:
         if self.graph is not None:
             self.graph.close()
+
+
+def _in_process():
+    """The in-process fallback (roc.ros.in_process, which imports rclpy): the client's one way to the
+    rclpy graph, for ``--no-daemon``, ``Session(use_daemon=False)`` and types the daemon lacks."""
+    from roc.ros import in_process
+
+    return in_process

@@ -18,7 +18,7 @@ from typing import Any
 
 from roc import __version__
 from roc.errors import RocError
-from roc.ros.client import discovery_environment
+from roc.ros.protocol import discovery_environment
 
 IDLE_SECONDS = float(os.environ.get("ROC_DAEMON_IDLE_SECONDS", "3600"))
 
@@ -56,7 +56,7 @@ class Daemon:
                     break
                 try:
                     conn, _ = listener.accept()
-                except socket.timeout:
+                except TimeoutError:
                     continue
                 threading.Thread(target=self._client, args=(conn,), daemon=True).start()
         finally:

@@ -27,11 +27,10 @@ from rclpy.qos import (
 )
 
 from roc.errors import RocError
-from roc.ros.graph import full_name
+from roc.ros.protocol import HEARTBEAT_SECONDS, full_name
 from roc.ros.raw_subscription import Receiver, gid_text
 from roc.ros.types import TF_TYPE, message_class
 
-HEARTBEAT_SECONDS = 0.5
 MAX_BATCH = 1000  # messages in one ``messages`` event
 # What roc's subscriptions keep when no depth is asked for: a burst waits for a busy reader rather than
 # being dropped (ros2 topic echo keeps 5; a bridge kept 10 and lost 0.8 % at 5 kHz).

@@ -25,7 +25,8 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from roc.errors import RocError
-from roc.ros.client import DEFAULT_SPIN_TIME
+from roc.ros.params import WRITES, parameter_value
+from roc.ros.protocol import DEFAULT_SPIN_TIME, PARAMETER_TYPES, full_name
 from roc.ros.raw_subscription import gid_text
 
 # Without a daemon, discovery lasts one Fast DDS announcement period and a margin (3.5 s: measured on
@@ -33,7 +34,7 @@ from roc.ros.raw_subscription import gid_text
 # 2 s: a participant outside the initial peers' range is heard at its next periodic announcement,
 # so no shorter quiet period is complete), then until the graph has been quiet for QUIET_SECONDS and
 # every endpoint's node is known, at most EXTRA_SECONDS longer. ``--spin-time`` sets the period
-# (DEFAULT_SPIN_TIME, in roc.ros.client so that verbs can read it without rclpy).
+# (DEFAULT_SPIN_TIME, in roc.ros.protocol so that verbs can read it without rclpy).
 QUIET_SECONDS = 0.3
 EXTRA_SECONDS = 1.0
 POLL_SECONDS = 0.05
@@ -76,10 +77,6 @@ def _endpoint(info) -> dict[str, Any]:
 
 def _names_and_types(pairs) -> list[dict[str, Any]]:
     return [{"name": name, "types": list(types)} for name, types in sorted(pairs)]
-
-
-def full_name(namespace: str, name: str) -> str:
-    return f"{namespace.rstrip('/')}/{name}"
 
 
 PROFILE_VARIABLES = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE")  # Fast DDS 2 (Jazzy), 3
@@ -334,36 +331,7 @@ class Graph:
         if method == "param_dump":
             names = self.param_names(params["node"])
             return dict(zip(names, self.param_values(params["node"], names)))
-        from roc.ros.params import WRITES
-
         if method in WRITES:
             return WRITES[method](self, params)
         raise RocError(f"unknown request '{method}'")
 
-
-PARAMETER_TYPES = {0: "not set", 1: "boolean", 2: "integer", 3: "double", 4: "string", 5: "byte array",
-                   6: "boolean array", 7: "integer array", 8: "double array", 9: "string array"}
-VALUE_FIELDS = {1: "bool_value", 2: "integer_value", 3: "double_value", 4: "string_value",
-                 5: "byte_array_value", 6: "bool_array_value", 7: "integer_array_value",
-                 8: "double_array_value", 9: "string_array_value"}
-
-
-def parameter_value(value) -> dict[str, Any]:
-    """{type, value} of an rcl_interfaces ParameterValue, the value as plain JSON data."""
-    field = VALUE_FIELDS.get(value.type)
-    data = getattr(value, field) if field else None
-    if field == "byte_array_value":
-        data = [b if isinstance(b, int) else ord(b) for b in data]
-    elif field and field.endswith("_array_value"):
-        data = list(data)
-    return {"type": PARAMETER_TYPES.get(value.type, "not set"), "value": data}
-
-
-def local_query(method: str, params: dict[str, Any], spin_time: float | None) -> Any:
-    """Answer one request without a daemon: a fresh participant, discovery, the query."""
-    graph = Graph()
-    try:
-        graph.wait_for_discovery(spin_time if spin_time is not None else DEFAULT_SPIN_TIME)
-        return graph.handle(method, params)
-    finally:
-        graph.close()

@@ -14,7 +14,7 @@ import array
 import math
 import sys
 from collections.abc import Callable, Iterable
-from functools import lru_cache, partial
+from functools import cache, partial
 from typing import Any
 
 import yaml
@@ -44,13 +44,13 @@ MSG_NAMES = {"boolean": "bool", "octet": "byte", "float": "float32", "double": "
 Fields = tuple[tuple[str, Any], ...]
 
 
-@lru_cache(maxsize=None)
+@cache
 def fields(cls: type) -> Fields:
     """``(name, rosidl definition)`` of each field of a message class, in definition order."""
     return tuple(zip(cls.get_fields_and_field_types(), cls.SLOT_TYPES))
 
 
-@lru_cache(maxsize=None)
+@cache
 def _field_map(cls: type) -> dict[str, Any]:
     return dict(fields(cls))
 

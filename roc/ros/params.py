@@ -1,5 +1,6 @@
-"""Writing a node's parameters over its parameter services (``param set``, ``delete``, ``load``).
-Values arrive typed as plain data, ``{"type": "integer", "value": 5}`` (roc.ros.graph's
+"""A node's parameter values as plain data, and writing them over its parameter services (``param set``,
+``delete``, ``load``).
+Values arrive typed as plain data, ``{"type": "integer", "value": 5}`` (roc.ros.protocol's
 PARAMETER_TYPES names; ``"not set"`` deletes), as ``param get`` returns them."""
 
 from __future__ import annotations
@@ -9,9 +10,20 @@ from typing import Any
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 
-from roc.ros.graph import PARAMETER_TYPES, VALUE_FIELDS
+from roc.ros.protocol import PARAMETER_TYPES, VALUE_FIELDS
 
 _TYPE_CODES = {name: code for code, name in PARAMETER_TYPES.items()}
+
+
+def parameter_value(value) -> dict[str, Any]:
+    """{type, value} of an rcl_interfaces ParameterValue, the value as plain JSON data."""
+    field = VALUE_FIELDS.get(value.type)
+    data = getattr(value, field) if field else None
+    if field == "byte_array_value":
+        data = [b if isinstance(b, int) else ord(b) for b in data]
+    elif field and field.endswith("_array_value"):
+        data = list(data)
+    return {"type": PARAMETER_TYPES.get(value.type, "not set"), "value": data}
 
 
 def to_parameter_value(data: dict[str, Any]) -> ParameterValue:

@@ -1,5 +1,5 @@
 """The streaming requests of the daemon protocol (docs/daemon.md), by name, and how to run one without
-the daemon."""
+the daemon (roc.ros.in_process)."""
 
 from __future__ import annotations
 
@@ -17,16 +17,3 @@ def run_on(graph, method: str, params: dict[str, Any], **in_process: Any) -> Ite
     """A stream on an existing Graph; its endpoint is destroyed when the caller stops iterating."""
     with contextlib.closing(STREAMS[method](graph, params, **in_process)) as events:
         yield from events
-
-
-def local_stream(method: str, params: dict[str, Any], node_name: str | None = None,
-                 **in_process: Any) -> Iterator[dict[str, Any]]:
-    """A stream without the daemon: its endpoint on a fresh participant of this process, on a node
-    named ``node_name`` (default: a hidden one)."""
-    from roc.ros.graph import Graph
-
-    graph = Graph(node_name)
-    try:
-        yield from run_on(graph, method, params, **in_process)
-    finally:
-        graph.close()

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import importlib
 import os
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -81,7 +81,7 @@ def _lookup(package: str, kind: str, name: str) -> type | None:
     return found if isinstance(found, type) else None
 
 
-@lru_cache(maxsize=None)
+@cache
 def _resolve(name: str, kind: str | None) -> type:
     package, given_kind, short = split_type_name(name)
     kinds = [given_kind] if given_kind else [kind] if kind else list(KINDS)

@@ -39,7 +39,7 @@ class Result:
     # The file's test suites as JUnit elements, for merging into one report.
     suites: list = field(default_factory=list, repr=False)
 
-    def add(self, other: "Result") -> None:
+    def add(self, other: Result) -> None:
         for name in COUNTS:
             setattr(self, name, getattr(self, name) + getattr(other, name))
         self.details += other.details

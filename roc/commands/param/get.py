@@ -1,0 +1,42 @@
+"""roc param get: a parameter's value (like ros2 param get)."""
+
+from __future__ import annotations
+
+import argparse
+
+from roc.cli.options import add_graph_arguments
+from roc.commands.graph_query import ask
+from roc.errors import RocError
+from roc.render import render
+
+LABELS = {"boolean": "Boolean value is:", "integer": "Integer value is:", "double": "Double value is:",
+          "string": "String value is:", "byte array": "Byte values are:", "boolean array": "Boolean values are:",
+          "integer array": "Integer values are:", "double array": "Double values are:",
+          "string array": "String values are:"}
+
+
+def python_text(value) -> str:
+    """The value as ros2 prints it (Python's str: True, [1.0, 2.0], ['a', 'b'])."""
+    return str(value)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("node_name", help="fully qualified node name, e.g. /talker")
+    parser.add_argument("parameter_name", help="name of the parameter")
+    parser.add_argument("--hide-type", action="store_true", help="print only the value")
+    add_graph_arguments(parser)
+
+
+def run(args: argparse.Namespace) -> int:
+    values = ask(args, "param_get", {"node": args.node_name, "names": [args.parameter_name]})
+    if not values:
+        raise RocError("Parameter not set")
+    value = values[0]
+    if value["type"] == "not set":
+        line = "Parameter not set."
+    elif args.hide_type:
+        line = python_text(value["value"])
+    else:
+        line = f"{LABELS[value['type']]} {python_text(value['value'])}"
+    render({"name": args.parameter_name, **value}, args.format, [line])
+    return 0

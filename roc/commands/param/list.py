@@ -1,0 +1,29 @@
+"""roc param list: the parameter names of one node or of every node (like ros2 param list)."""
+
+from __future__ import annotations
+
+import argparse
+
+from roc.cli.options import add_graph_arguments
+from roc.commands.graph_query import ask
+from roc.render import render
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("node_name", nargs="?", help="fully qualified node name; every node when left out")
+    parser.add_argument("--param-prefixes", nargs="+", default=[], metavar="PREFIX",
+                        help="only parameters with one of these prefixes")
+    parser.add_argument("--param-type", action="store_true", help="print each parameter's type")
+    add_graph_arguments(parser)
+
+
+def run(args: argparse.Namespace) -> int:
+    nodes = ask(args, "param_list", {"node": args.node_name, "prefixes": args.param_prefixes, "types": args.param_type})
+    lines = []
+    for entry in nodes:
+        if not args.node_name:
+            lines.append(f"{entry['node']}:")
+        lines += [f"  {p['name']} (type: {p['type']})" if args.param_type else f"  {p['name']}"
+                  for p in entry["parameters"]]
+    render(nodes, args.format, lines)
+    return 0

@@ -1,0 +1,181 @@
+"""``roc work build``: build the workspace, a drop-in for ``colcon build``."""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+
+from roc.cli.options import add_layout_arguments, add_selection_arguments
+from roc.errors import EXIT_FAILURE, EXIT_INTERRUPTED, UsageError
+from roc.handlers import add_event_handlers_argument, handler_switches, output_handlers
+
+NOT_SUPPORTED_OPTIONS = ("test_result_base", "catkin_cmake_args",
+                         "catkin_skip_building_tests")
+DURATIONS_FILE = "roc_durations.json"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    add = parser.add_argument
+    add("packages", nargs="*", metavar="PKG_NAME", help="shorthand for --packages-up-to PKG_NAME...")
+    add_layout_arguments(parser)
+    add("--log-base", default="log", help="base directory of the logs, or /dev/null for none (default: log)")
+    add("--continue-on-error", action="store_true",
+        help="keep building packages that do not depend on a failed one (default: stop at the first failure)")
+    add("--executor", choices=("parallel", "sequential"), default="parallel", help="run packages in parallel "
+        "(default) or one at a time")
+    add("--parallel-workers", type=int, metavar="NUMBER", default=os.cpu_count() or 1,
+        help="packages built at once, 0 for no limit (default: the number of CPUs)")
+    add("-j", "--jobs", type=int, metavar="N",
+        help="compiler jobs of all packages together (default: -j of MAKEFLAGS, else the number of CPUs)")
+    add_event_handlers_argument(parser)
+    add("--output", choices=("text", "json"), default="text", help="json: one JSON event per line on stdout")
+    add("--allow-overriding", action="extend", nargs="+", default=[], metavar="PKG_NAME",
+        help="build these packages without the warning that an underlay workspace has them too")
+    add("--force", action="store_true", help="rebuild the selected packages even when they are up to date")
+    add("--explain", action="store_true",
+        help="build nothing: print each selected package, in build order, and why it would be built")
+    add("--no-cache", action="store_true",
+        help="neither skip up-to-date packages nor record fingerprints for the next build")
+    cmake = parser.add_argument_group("cmake and ament_cmake packages")
+    cmake.add_argument("--cmake-target", help="build this target instead of the default one (no install)")
+    cmake.add_argument("--cmake-target-skip-unavailable", action="store_true",
+                       help="skip packages that do not have the --cmake-target")
+    cmake.add_argument("--cmake-clean-cache", action="store_true", help="remove the CMake cache first")
+    cmake.add_argument("--cmake-clean-first", action="store_true", help="build target 'clean' first")
+    cmake.add_argument("--cmake-force-configure", action="store_true", help="always run the CMake configure step")
+    unsupported = parser.add_argument_group("colcon options roc does not support yet (rejected if used)")
+    unsupported.add_argument("--test-result-base", help=argparse.SUPPRESS)
+    unsupported.add_argument("--catkin-cmake-args", nargs="*", help=argparse.SUPPRESS)
+    unsupported.add_argument("--catkin-skip-building-tests", action="store_true", default=None,
+                             help=argparse.SUPPRESS)
+    add_selection_arguments(parser)
+
+
+def build_options(args: argparse.Namespace, root: Path, **extra):
+    """BuildOptions from the command line and the configuration's per-package settings."""
+    from roc.buildtypes.context import BuildOptions
+
+    config = getattr(args, "configuration", None)
+    per_package = {key: {name: tuple(value) for name, value in config.package_values(key).items()}
+                   if config else {} for key in ("cmake-args", "ament-cmake-args")}
+    return BuildOptions(
+        build_base=(root / args.build_base).absolute(), install_base=(root / args.install_base).absolute(),
+        merge_install=args.merge_install, symlink_install=args.symlink_install,
+        cmake_args=tuple(args.cmake_args), ament_cmake_args=tuple(args.ament_cmake_args),
+        package_cmake_args=per_package["cmake-args"], package_ament_cmake_args=per_package["ament-cmake-args"],
+        **extra,
+    )
+
+
+def skip_unbuildable_packages(workspace) -> None:
+    """Packages of a build type roc has no handler for are skipped with a warning, as colcon does."""
+    from roc.buildtypes import BUILD_TYPES
+    from roc.messages import warn
+
+    for package in workspace.selected_in_order():
+        if package.type not in BUILD_TYPES:
+            warn(f"{package.path}: no way to build '{package.name}' of type '{package.type}' "
+                 f"(roc builds {', '.join(sorted(BUILD_TYPES))}); skipped")
+            workspace.selected.discard(package.name)
+
+
+def skip_configured_packages(args: argparse.Namespace, workspace) -> None:
+    """Packages with ``skip = true`` in roc.toml are not built (they stay in the graph)."""
+    config = getattr(args, "configuration", None)
+    if config:
+        workspace.selected -= {name for name, skip in config.package_values("skip").items() if skip}
+
+
+def warn_about_overrides(args: argparse.Namespace, workspace, install_base: Path) -> None:
+    """colcon-override-check's warning: a selected package shadows one that underlay packages use."""
+    from roc.messages import warn
+    from roc.workspace.underlay import overridden_packages, override_warning
+
+    for name in args.allow_overriding:
+        if name not in workspace.by_name:
+            warn(f"--allow-overriding: ignoring unknown package '{name}'")
+    overridden = overridden_packages(workspace.selected, install_base, args.allow_overriding, os.environ)
+    if overridden:
+        warn(override_warning(overridden))
+
+
+def _explain(args: argparse.Namespace, workspace, options) -> int:
+    from roc.builder.uptodate import explain
+    from roc.engine.events import task_key
+    from roc.render import print_json, print_lines
+
+    explained = explain(workspace, options)
+    if args.output == "json":
+        print_json([{"package": name, "kind": kind, "reasons": reasons} for kind, name, reasons in explained])
+    else:
+        print_lines([f"{task_key(kind, name)}: {'; '.join(reasons) or 'up to date'}" for kind, name, reasons in explained])
+    return 0
+
+
+def _check_supported(args: argparse.Namespace) -> None:
+    for option in NOT_SUPPORTED_OPTIONS:
+        if getattr(args, option) not in (None, False):
+            raise UsageError(f"--{option.replace('_', '-')} is not supported by roc yet")
+
+
+def run(args: argparse.Namespace) -> int:
+    from roc.builder.layout import prepare_build_base, prepare_install_base
+    from roc.workspace.load import load_workspace
+
+    _check_supported(args)
+    switches = handler_switches(args.event_handlers)
+    if args.packages:
+        args.packages_up_to = [*(args.packages_up_to or []), *args.packages]
+    if args.parallel_workers < 0:
+        raise UsageError("--parallel-workers must be 0 (no limit) or more")
+    if args.jobs is not None and args.jobs < 1:
+        raise UsageError("-j/--jobs must be 1 or more")
+    from roc.builder.lock import build_lock
+    from roc.engine.jobserver import jobs_from_makeflags
+
+    workspace = load_workspace(args)
+    skip_configured_packages(args, workspace)
+    skip_unbuildable_packages(workspace)
+    jobs = args.jobs or jobs_from_makeflags(os.environ.get("MAKEFLAGS", "")) or os.cpu_count() or 1
+    workers = 1 if args.executor == "sequential" else args.parallel_workers or len(workspace.selected) or 1
+    options = build_options(
+        args, workspace.root, cmake_target=args.cmake_target,
+        cmake_target_skip_unavailable=args.cmake_target_skip_unavailable,
+        cmake_clean_cache=args.cmake_clean_cache, cmake_clean_first=args.cmake_clean_first,
+        cmake_force_configure=args.cmake_force_configure, jobs=jobs, jobs_per_package=max(1, jobs // workers),
+        force=args.force,
+        use_state=not args.no_cache,
+    )
+    if args.explain:
+        return _explain(args, workspace, options)
+    warn_about_overrides(args, workspace, options.install_base)
+    with build_lock(options.build_base):
+        prepare_build_base(options.build_base)
+        prepare_install_base(options.install_base, args.merge_install)
+        return _build(args, workspace, options, switches)
+
+
+def _build(args, workspace, options, switches: dict[str, bool]) -> int:
+    from roc.builder.layout import refresh_install_scripts
+    from roc.builder.plan import plan_build
+    from roc.engine.executor import execute
+    from roc.engine.jobserver import Jobserver
+    from roc.engine.store import DurationStore
+
+    workers = 1 if args.executor == "sequential" else args.parallel_workers
+    durations = DurationStore(options.build_base / DURATIONS_FILE)
+    jobserver = Jobserver(options.jobs)
+    handlers = [*output_handlers(args, switches, workspace.root, options.build_base), durations]
+    try:
+        tasks = plan_build(workspace, options, jobserver, durations.durations)
+        result = execute(tasks, handlers, workers, continue_on_error=args.continue_on_error)
+    finally:
+        jobserver.close()
+        for handler in handlers:  # e.g. the terminal's live line, when the run ended by an error
+            getattr(handler, "close", lambda: None)()
+    durations.save()
+    refresh_install_scripts(options.install_base, args.merge_install)
+    if result.interrupted:
+        return EXIT_INTERRUPTED
+    return 0 if result.ok else EXIT_FAILURE

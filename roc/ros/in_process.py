@@ -1,0 +1,48 @@
+"""The in-process fallback of roc.ros.client: queries and streams on a participant of this process
+(``--no-daemon``, or a type the daemon's environment lacks). The one seam through which the client
+reaches the rclpy graph; importing this module imports rclpy."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+from roc.ros.graph import Graph
+from roc.ros.protocol import DEFAULT_SPIN_TIME
+from roc.ros.streams import run_on
+
+
+def discovered_graph(spin_time: float | None = None, node_name: str | None = None) -> Graph:
+    """A fresh participant that has waited for discovery (``spin_time``, default DEFAULT_SPIN_TIME)."""
+    graph = Graph(node_name)
+    try:
+        graph.wait_for_discovery(spin_time if spin_time is not None else DEFAULT_SPIN_TIME)
+    except BaseException:
+        graph.close()
+        raise
+    return graph
+
+
+def query(method: str, params: dict[str, Any], spin_time: float | None) -> Any:
+    """Answer one request without a daemon: a fresh participant, discovery, the query."""
+    graph = discovered_graph(spin_time)
+    try:
+        return graph.handle(method, params)
+    finally:
+        graph.close()
+
+
+def stream(method: str, params: dict[str, Any], node_name: str | None = None,
+           **in_process: Any) -> Iterator[dict[str, Any]]:
+    """A stream without the daemon: its endpoint on a fresh participant of this process, on a node
+    named ``node_name`` (default: a hidden one)."""
+    graph = Graph(node_name)
+    try:
+        yield from run_on(graph, method, params, **in_process)
+    finally:
+        graph.close()
+
+
+def stream_on(graph: Graph, method: str, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+    """A stream on a participant made by discovered_graph."""
+    return run_on(graph, method, params)

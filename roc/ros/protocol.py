@@ -1,0 +1,33 @@
+"""What the daemon client, the daemon, the rclpy graph and the data plane share, without rclpy: the
+discovery variables, discovery timing, name rules and the parameter type names of the wire format
+(docs/daemon.md). Every module of roc/ros/ may import this one; it imports none of them."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+
+# The variables that decide what a participant discovers: a daemon serves one set of values.
+DISCOVERY_VARIABLES = ("ROS_DOMAIN_ID", "RMW_IMPLEMENTATION", "ROS_AUTOMATIC_DISCOVERY_RANGE",
+                       "ROS_STATIC_PEERS", "ROS_LOCALHOST_ONLY")
+# Daemon-less discovery lasts this long at least (see roc.ros.graph: Graph.wait_for_discovery).
+DEFAULT_SPIN_TIME = 3.5
+# A stream sends an event at least this often, so a client can act between messages.
+HEARTBEAT_SECONDS = 0.5
+
+# rcl_interfaces' ParameterType codes, by the names roc sends on the wire ({"type": ..., "value": ...}).
+PARAMETER_TYPES = {0: "not set", 1: "boolean", 2: "integer", 3: "double", 4: "string", 5: "byte array",
+                   6: "boolean array", 7: "integer array", 8: "double array", 9: "string array"}
+VALUE_FIELDS = {1: "bool_value", 2: "integer_value", 3: "double_value", 4: "string_value",
+                5: "byte_array_value", 6: "bool_array_value", 7: "integer_array_value",
+                8: "double_array_value", 9: "string_array_value"}
+
+
+def discovery_environment(env: Mapping[str, str] | None = None) -> dict[str, str]:
+    env = os.environ if env is None else env
+    return {name: env.get(name, "") for name in DISCOVERY_VARIABLES}
+
+
+def full_name(namespace: str, name: str) -> str:
+    """A node's full name from its namespace and name (``/ns`` + ``n`` -> ``/ns/n``)."""
+    return f"{namespace.rstrip('/')}/{name}"

@@ -1,0 +1,51 @@
+"""The tests' ROS domains: one setting (ROC_TEST_DOMAIN_BASE) moves every domain the suite uses, and no
+two slots or workers share one."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+from build_helpers import DOMAIN_MAX, DOMAIN_SLOTS, ros_domain_id
+
+TESTS = Path(__file__).resolve().parent
+
+
+def _domains(monkeypatch, base: str, workers: int) -> list[int]:
+    monkeypatch.setenv("ROC_TEST_DOMAIN_BASE", base)
+    monkeypatch.setenv("PYTEST_XDIST_WORKER_COUNT", str(workers))
+    domains = []
+    for worker in range(workers):
+        monkeypatch.setenv("PYTEST_XDIST_WORKER", f"gw{worker}")
+        domains += [int(ros_domain_id(slot)) for slot in range(DOMAIN_SLOTS)]
+    return domains
+
+
+def test_the_base_moves_every_domain_and_none_is_shared(monkeypatch):
+    default = _domains(monkeypatch, "20", 2)
+    moved = _domains(monkeypatch, "120", 2)
+    assert len(set(default)) == len(default) == 2 * DOMAIN_SLOTS
+    assert sorted(moved) == [d + 100 for d in sorted(default)]
+    assert min(default) == 20 and max(moved) <= DOMAIN_MAX
+
+
+def test_a_base_too_high_or_not_a_number_is_refused(monkeypatch):
+    with pytest.raises(ValueError, match="choose a lower base"):
+        _domains(monkeypatch, "220", 2)
+    with pytest.raises(ValueError, match="expected a ROS domain id"):
+        _domains(monkeypatch, "x", 1)
+
+
+def test_no_test_hard_codes_a_domain():
+    """Every test that sets ROS_DOMAIN_ID takes it from a slot (ros_domain_id or graph_env), and no two
+    test files share a slot."""
+    owners: dict[int, set[str]] = {}
+    for path in TESTS.glob("test_*.py"):
+        text = path.read_text()
+        assert not re.search(r"ROS_DOMAIN_ID[\"']?\s*[:=]\s*[\"']?\d", text.replace('"ROS_DOMAIN_ID", "7"', "")
+                             .replace('"ROS_DOMAIN_ID": "3"', "")), path.name
+        for slot in re.findall(r"(?:ros_domain_id|graph_env)\((\d+)", text):
+            owners.setdefault(int(slot), set()).add(path.name)
+    shared = {slot: files for slot, files in owners.items() if len(files) > 1}
+    assert not shared, f"domain slots used by several test files: {shared}"
