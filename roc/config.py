@@ -24,6 +24,7 @@ import argparse
 import os
 import re
 from pathlib import Path
+from typing import Any
 
 from roc.errors import UsageError
 from roc.messages import did_you_mean, unknown_package
@@ -194,8 +195,8 @@ def _load_colcon_defaults(config: Configuration, root: Path, verb: str) -> None:
 
 def _check_package_setting(setting: Setting) -> None:
     expected = PACKAGE_KEYS[setting.key]
-    value = setting.value
-    if not isinstance(value, expected) or (expected is list and not all(isinstance(v, str) for v in value)):
+    value: Any = setting.value
+    if not isinstance(value, expected) or (isinstance(value, list) and not all(isinstance(v, str) for v in value)):
         kind = "a list of strings" if expected is list else "true or false"
         raise ConfigError(setting.path, setting.key, f"must be {kind}, not {value!r}", setting.line)
 

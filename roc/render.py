@@ -60,7 +60,7 @@ def _message_dumper(fast: bool) -> type:
     rosidl_runtime_py's OrderedDict representer does."""
     import yaml
 
-    class MessageDumper(yaml.CDumper if fast else yaml.Dumper):  # type: ignore[misc,name-defined]
+    class MessageDumper(yaml.CDumper if fast else yaml.Dumper):  # type: ignore[misc]
         pass
 
     def block_mapping(dumper: yaml.Dumper, mapping: dict) -> yaml.MappingNode:

@@ -98,13 +98,14 @@ class TaskContext:
         return returncode
 
     def _pump(self, process: subprocess.Popen) -> None:
+        assert process.stdout is not None and process.stderr is not None  # started with PIPE for both
         with selectors.DefaultSelector() as selector:
             selector.register(process.stdout, selectors.EVENT_READ, "stdout")
             selector.register(process.stderr, selectors.EVENT_READ, "stderr")
             open_streams = 2
             while open_streams:
                 for key, _ in selector.select():
-                    data = os.read(key.fileobj.fileno(), 65536)
+                    data = os.read(key.fd, 65536)
                     if not data:
                         selector.unregister(key.fileobj)
                         open_streams -= 1

@@ -4,6 +4,7 @@ between rotation representations, on transforms3d (which orders quaternions w, x
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy
@@ -15,6 +16,11 @@ AXES = ("sxyz", "sxzy", "syxz", "syzx", "szxy", "szyx", "rxyz", "rxzy", "ryxz", 
 def _wxyz(quaternion: tuple[float, float, float, float]) -> numpy.ndarray:
     x, y, z, w = quaternion
     return numpy.array([w, x, y, z], dtype=float)
+
+
+def vector(values: Iterable[float]) -> tuple[float, float, float]:
+    x, y, z = (float(v) for v in values)
+    return (x, y, z)
 
 
 def _xyzw(wxyz: numpy.ndarray) -> tuple[float, float, float, float]:
@@ -52,12 +58,12 @@ class Transform:
         """``self`` then ``other`` in ``self``'s frame: parent->child composed with child->grandchild."""
         q = _wxyz(self.rotation)
         moved = quaternions.rotate_vector(numpy.array(other.translation), q) + numpy.array(self.translation)
-        return Transform(tuple(float(v) for v in moved), _xyzw(quaternions.qmult(q, _wxyz(other.rotation))))
+        return Transform(vector(moved), _xyzw(quaternions.qmult(q, _wxyz(other.rotation))))
 
     def inverse(self) -> Transform:
         q = quaternions.qinverse(_wxyz(self.rotation))
         moved = -quaternions.rotate_vector(numpy.array(self.translation), q)
-        return Transform(tuple(float(v) for v in moved), _xyzw(q))
+        return Transform(vector(moved), _xyzw(q))
 
     def euler(self, axes: str = "sxyz") -> tuple[float, float, float]:
         return tuple(float(v) for v in euler.quat2euler(_wxyz(self.rotation), axes))  # type: ignore[return-value]
@@ -86,4 +92,4 @@ def interpolate(before: Transform, after: Transform, fraction: float) -> Transfo
     axis, angle = quaternions.quat2axangle(relative)
     rotation = quaternions.qmult(q0, quaternions.axangle2quat(axis, angle * fraction))
     translation = (1 - fraction) * numpy.array(before.translation) + fraction * numpy.array(after.translation)
-    return Transform(tuple(float(v) for v in translation), _xyzw(rotation))
+    return Transform(vector(translation), _xyzw(rotation))

@@ -127,7 +127,7 @@ class ConsoleHandler:
         if self.status is not None:
             self.status(event)
 
-    def _ended(self, event: Event) -> None:
+    def _ended(self, event: TaskFinished | TaskFailed | TaskAborted) -> None:
         key, name = event.key, self.label(event)  # name: the package for the run's own kind (as colcon)
         if self.cohesion and key in self._all:
             self._print(f"--- output: {name}\n{self._all[key].decode(errors='replace').rstrip()}\n---")

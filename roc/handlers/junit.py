@@ -42,8 +42,8 @@ class JUnitReport:
                 element.text = result.message
             else:
                 ElementTree.SubElement(case, "system-out").text = result.message
-        document = ElementTree.ElementTree(ElementTree.Element("testsuites"))
-        document.getroot().append(suite)
-        ElementTree.indent(document)
-        text = ElementTree.tostring(document.getroot(), encoding="unicode", xml_declaration=True)
+        root = ElementTree.Element("testsuites")
+        root.append(suite)
+        ElementTree.indent(root)
+        text = ElementTree.tostring(root, encoding="unicode", xml_declaration=True)
         write_text_atomic(self.path, text + "\n")

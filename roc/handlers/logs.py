@@ -12,6 +12,7 @@ import shlex
 import time
 from dataclasses import asdict
 from pathlib import Path
+from typing import BinaryIO
 
 from roc.engine.events import (
     CommandEnded,
@@ -72,7 +73,7 @@ class LogHandler:
         self.kind = kind
         self.commands = commands
         self._events = open(directory / "events.log", "a", buffering=1) if events else None
-        self._files: dict[tuple[str, str], object] = {}
+        self._files: dict[tuple[str, str], BinaryIO] = {}
 
     def task_directory(self, event: Event) -> Path:
         return self.directory / task_log_folder(event, self.kind)

@@ -3,6 +3,8 @@ measured, served as Prometheus metrics (prometheus-client) on http://ADDRESS:POR
 
 from __future__ import annotations
 
+from typing import Any
+
 from prometheus_client import CollectorRegistry, Gauge, start_http_server
 
 from roc.engine.events import Event, ProbeResult, TaskFailed, TaskFinished
@@ -24,7 +26,7 @@ class PrometheusMetrics:
         self.endpoints = Gauge("roc_topic_endpoints", "endpoints of a topic", ["topic", "side"],
                                registry=self.registry)
         self.rounds = Gauge("roc_check_rounds", "rounds of probes run", registry=self.registry)
-        self.server = None
+        self.server: Any = None  # prometheus_client's WSGIServer while serving
 
     def serve(self, port: int, address: str = "127.0.0.1") -> None:
         self.server, _ = start_http_server(port, address, registry=self.registry)

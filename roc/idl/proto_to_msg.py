@@ -5,6 +5,7 @@ from __future__ import annotations
 import codecs
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 from roc.errors import RocError
 from roc.idl import naming
@@ -41,8 +42,8 @@ class Definition:
     """A message or enum of the descriptor set."""
 
     full: str  # a.b.Robot.Status
-    proto: object  # DescriptorProto | EnumDescriptorProto
-    file: object  # FileDescriptorProto
+    proto: Any  # DescriptorProto | EnumDescriptorProto
+    file: Any  # FileDescriptorProto
     path: tuple[int, ...]  # source-info path
     is_enum: bool
     package: str = ""  # ROS package
@@ -52,11 +53,11 @@ class Definition:
 
 @dataclass
 class Converter:
-    files: object  # FileDescriptorSet
+    files: Any  # FileDescriptorSet
     config: Config
     package: str | None
     definitions: dict[str, Definition] = field(default_factory=dict)
-    lines: dict[str, dict[tuple[int, ...], object]] = field(default_factory=dict)
+    lines: dict[str, dict[tuple[int, ...], Any]] = field(default_factory=dict)  # SourceCodeInfo.Location
     notes: list[str] = field(default_factory=list)
 
     def __post_init__(self) -> None:

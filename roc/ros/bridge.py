@@ -20,7 +20,7 @@ from __future__ import annotations
 import os
 import re
 import time
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -68,12 +68,12 @@ class TopicFilter:
     """``--include``/``--exclude``: a name passes when it matches one of ``include`` (any name when
     empty) and none of ``exclude`` (regular expressions, searched)."""
 
-    def __init__(self, include: list[str] = (), exclude: list[str] = ()) -> None:
+    def __init__(self, include: Sequence[str] = (), exclude: Sequence[str] = ()) -> None:
         try:
             self.include = [re.compile(pattern) for pattern in include]
             self.exclude = [re.compile(pattern) for pattern in exclude]
         except re.error as error:
-            raise UsageError(f"--include/--exclude: invalid regular expression '{error.pattern}': {error}") from None
+            raise UsageError(f"--include/--exclude: invalid regular expression '{error.pattern!s}': {error}") from None
 
     def __call__(self, name: str) -> bool:
         return (not any(p.search(name) for p in self.exclude)
@@ -98,7 +98,7 @@ def two_way(routes: list[Route]) -> list[str]:
                         or (r.name == "*" and any(d == r.from_domain for d, _ in published)))})
 
 
-def loop_guard(routes: list[Route], environment: dict[str, str] = os.environ) -> None:
+def loop_guard(routes: list[Route], environment: Mapping[str, str] = os.environ) -> None:
     """Keep the bridge's own publications from reaching its subscriptions (see the module docstring):
     the bridge's Graphs take BRIDGE_PROFILE, unless the user gave a profile, which must then set the
     property when a topic is bridged both ways; other middlewares cannot bridge both ways."""
@@ -139,7 +139,7 @@ class _TopicLink:
 
 
 class DomainBridge:
-    def __init__(self, routes: list[Route], include: list[str] = (), exclude: list[str] = (),
+    def __init__(self, routes: list[Route], include: Sequence[str] = (), exclude: Sequence[str] = (),
                  everything: tuple[int, int] | None = None):
         """``routes``: the topics and services named; ``everything`` (from, to): also every topic of the
         source domain whose name matches one of ``include`` (all when empty) and none of ``exclude``.
@@ -218,7 +218,7 @@ class DomainBridge:
         """``bridging`` events as topics and services are bridged, ``error`` events (a bridged call that
         found no server) and a ``rates`` event every ``period`` seconds (messages or calls a second per
         bridged name), until closed."""
-        last, counts = time.monotonic(), {}
+        last, counts = time.monotonic(), dict[tuple, int]()
         next_scan = 0.0
         connect = {"topic": self._connect_topic, "service": self._connect_service}
         while True:

@@ -14,7 +14,7 @@ from typing import Any
 from rclpy.serialization import deserialize_message
 
 from roc.ros.cdr import serialize
-from roc.ros.protocol import HEARTBEAT_SECONDS
+from roc.ros.protocol import HEARTBEAT_SECONDS, Events
 from roc.ros.types import action_class, service_class
 
 
@@ -24,7 +24,7 @@ def _wait(done: Callable[[], bool]) -> Iterator[dict[str, Any]]:
         yield {"event": "heartbeat"}
 
 
-def call(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+def call(graph, params: dict[str, Any]) -> Events:
     """Call ``params["service"]`` (a ``type`` service) with ``request`` (base64 CDR): ``waiting`` while
     no server is available, then ``request`` and ``response {data}`` per call; with ``rate`` (Hz) again
     and again until closed."""
@@ -55,7 +55,7 @@ GOAL_STATUS = {0: "UNKNOWN", 1: "ACCEPTED", 2: "EXECUTING", 3: "CANCELING", 4: "
                6: "ABORTED"}
 
 
-def goal(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+def goal(graph, params: dict[str, Any]) -> Events:
     """Send ``params["goal"]`` (base64 CDR of a ``type`` action's Goal) to ``action``: ``waiting``
     while no server is available, then ``accepted {goal_id}`` (or ``rejected``), ``feedback {data}``
     (with ``feedback``), and ``result {data, status}``. Closed before the result, the goal is

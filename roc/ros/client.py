@@ -13,14 +13,13 @@ import socket
 import sys
 import time
 import zlib
-from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 from roc import __version__
 from roc.errors import RocError
-from roc.ros.protocol import discovery_environment
+from roc.ros.protocol import Events, discovery_environment
 
 REQUEST_TIMEOUT = float(os.environ.get("ROC_DAEMON_TIMEOUT", "30"))
 START_TIMEOUT = 15.0
@@ -71,7 +70,7 @@ class Connection:
         self.next_id = 0
 
     def stream(self, method: str, params: dict[str, Any] | None = None,
-               timeout: float = REQUEST_TIMEOUT) -> Iterator[dict[str, Any]]:
+               timeout: float = REQUEST_TIMEOUT) -> Events:
         """Send a request; yield each response line until the final one (``"final": true``)."""
         self.next_id += 1
         request = {"id": self.next_id, "method": method, "params": params or {}}
@@ -217,7 +216,7 @@ def query(method: str, params: dict[str, Any] | None = None, *, use_daemon: bool
 
 
 def stream(method: str, params: dict[str, Any], *, use_daemon: bool = True, heartbeats: bool = False,
-           **local: Any) -> Iterator[dict[str, Any]]:
+           **local: Any) -> Events:
     """The events of a streaming request (roc.ros.dataplane), in the daemon unless ``use_daemon`` is
     false (``local``: options of roc.ros.in_process.stream), or in this process when the daemon
     cannot import the type; closing the iterator (or Ctrl+C) ends the stream and removes its endpoint.
@@ -263,7 +262,7 @@ class Session:
             return self.graph.handle(method, params or {})
         return query(method, params)
 
-    def stream(self, method: str, params: dict[str, Any], heartbeats: bool = False) -> Iterator[dict[str, Any]]:
+    def stream(self, method: str, params: dict[str, Any], heartbeats: bool = False) -> Events:
         if self.graph is None:
             yield from stream(method, params, heartbeats=heartbeats)
             return

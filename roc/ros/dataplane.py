@@ -14,7 +14,7 @@ from __future__ import annotations
 import base64
 import struct
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from typing import Any
 
 from rclpy.qos import (
@@ -27,7 +27,7 @@ from rclpy.qos import (
 )
 
 from roc.errors import RocError
-from roc.ros.protocol import HEARTBEAT_SECONDS, full_name
+from roc.ros.protocol import HEARTBEAT_SECONDS, Events, full_name
 from roc.ros.raw_subscription import Receiver, gid_text
 from roc.ros.types import TF_TYPE, message_class
 
@@ -108,7 +108,7 @@ def _topic_class(graph, topic: str, params: dict[str, Any], wait_for_type: bool)
     return cls, type_name, found
 
 
-def echo(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+def echo(graph, params: dict[str, Any]) -> Events:
     """Subscribe to ``params["topic"]`` and yield ``{"event": "messages", "messages": [{data, info,
     lost}]}`` with what arrived since the last event (``lost``: messages the publisher's sequence
     numbers say never arrived), ``{"event": "subscribed", "type"}`` first and heartbeats in between.
@@ -147,7 +147,7 @@ def echo(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
         receiver.close()
 
 
-def publish(graph, params: dict[str, Any], prepare: Callable[[], bytes] | None = None) -> Iterator[dict[str, Any]]:
+def publish(graph, params: dict[str, Any], prepare: Callable[[], bytes] | None = None) -> Events:
     """Publish ``params["data"]`` (base64 CDR of a ``type`` message) on ``topic``: wait for ``wait``
     matching subscriptions (``{"event": "waiting"}`` each second, at most ``max_wait`` seconds), then
     ``times`` messages (0: until closed) at ``rate`` Hz, ``{"event": "published", "count"}`` after each,
@@ -202,7 +202,7 @@ def header_stamp_ns(data: bytes) -> int | None:
     return sec * 1_000_000_000 + nanosec
 
 
-def stats(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+def stats(graph, params: dict[str, Any]) -> Events:
     """Subscribe to each of ``params["topics"]`` and yield, every ``period`` seconds, a ``batch`` of
     what arrived: per topic, lists of publication sequence numbers, source and reception timestamps
     (ns), serialised sizes and, with ``stamps``, header stamps (ns) — never deserialising a message,
@@ -232,7 +232,7 @@ def stats(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
         receiver.close()
 
 
-def frames(graph, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+def frames(graph, params: dict[str, Any]) -> Events:
     """Subscribe to /tf (QoS following the publishers known, else reliable as tf2's listener; depth
     100) and /tf_static (transient local, as tf2's static listener does) and yield ``messages
     {messages: [{static, data, received, publisher}]}`` batches of TFMessage CDR (``publisher``: the

@@ -33,7 +33,7 @@ import queue
 import re
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -45,6 +45,7 @@ from rosidl_parser import definition as idl
 from websockets.asyncio.client import connect
 from websockets.asyncio.server import serve
 from websockets.exceptions import ConnectionClosed
+from websockets.typing import Subprotocol
 
 from roc.errors import RocError
 from roc.ros.bridge import TopicFilter, receive_profile
@@ -53,7 +54,7 @@ from roc.ros.dataplane import qos_profile
 from roc.ros.graph import Graph
 from roc.ros.interfaces import definition_path
 from roc.ros.messages import fill_message
-from roc.ros.types import message_class, type_name
+from roc.ros.types import InterfaceClass, message_class, type_name
 
 SCAN_SECONDS = 1.0
 LATCHED = DurabilityPolicy.TRANSIENT_LOCAL
@@ -72,7 +73,7 @@ def schema_text(name: str) -> str:
     parts: list[str] = []
     seen: set[str] = set()
 
-    def add(cls: type, nested: bool) -> None:
+    def add(cls: InterfaceClass, nested: bool) -> None:
         name_ = type_name(cls)
         path = definition_path(name_)
         if path.suffix != ".msg":
@@ -97,7 +98,7 @@ class _Topic:
     """An advertised topic: its channel, and its ROS subscription while clients subscribe."""
 
     type: str
-    cls: type
+    cls: InterfaceClass
     channel: Channel
     subscription: Any = None
     clients: set[int] = field(default_factory=set)
@@ -134,14 +135,14 @@ class _Relay:
             raise RocError(f"cannot listen on {host}:{port}: {error.strerror or error}") from None
 
     async def _start(self, host: str, port: int):
-        return await serve(self._relay, host, port, subprotocols=list(SUBPROTOCOLS), compression=None,
+        return await serve(self._relay, host, port, subprotocols=[Subprotocol(name) for name in SUBPROTOCOLS], compression=None,
                            max_size=None, close_timeout=CLOSE_SECONDS)
 
     async def _relay(self, client) -> None:
         peer = ":".join(str(part) for part in client.remote_address[:2])
         self.events.put({"event": "client_connected", "client": peer, "subprotocol": client.subprotocol})
         try:
-            async with connect(f"ws://127.0.0.1:{self.upstream}", subprotocols=[SUBPROTOCOLS[0]],
+            async with connect(f"ws://127.0.0.1:{self.upstream}", subprotocols=[Subprotocol(SUBPROTOCOLS[0])],
                                compression=None, max_size=None, close_timeout=CLOSE_SECONDS) as server:
                 session = _Session(client, server)
                 pumps = [asyncio.ensure_future(session.upward()), asyncio.ensure_future(session.downward())]
@@ -245,9 +246,10 @@ class FoxgloveServer:
     ROS_DOMAIN_ID); ``run`` drives it, ``close`` stops all three."""
 
     def __init__(self, host: str = "127.0.0.1", port: int = 8765, domain: int | None = None,
-                 include: list[str] = (), exclude: list[str] = ()) -> None:
+                 include: Sequence[str] = (), exclude: Sequence[str] = ()) -> None:
         self._wanted = TopicFilter(include, exclude)
-        self.host, self.events = host, queue.Queue()
+        self.host = host
+        self.events: queue.Queue[dict[str, Any]] = queue.Queue()
         self.topics: dict[str, _Topic] = {}
         self.skipped: set[str] = set()
         self.client_topics: dict[tuple[int, int], _ClientTopic] = {}
@@ -270,7 +272,8 @@ class FoxgloveServer:
 
     def close(self) -> None:
         self.relay.close()
-        self.sdk.stop()
+        if self.sdk is not None:
+            self.sdk.stop()
         with self.lock:
             for topic in self.topics.values():
                 topic.channel.close()
@@ -388,7 +391,8 @@ class FoxgloveServer:
         yield {"event": "serving", "url": f"ws://{self.host}:{self.port}", "host": self.host, "port": self.port,
                "domain": self.graph.context.get_domain_id(), "subprotocols": list(SUBPROTOCOLS)}
         now = time.monotonic()
-        next_scan, last_rates, counts = now, now, {}
+        next_scan, last_rates = now, now
+        counts: dict[str, int] = {}
         while True:
             now = time.monotonic()
             if now >= next_scan:

@@ -4,11 +4,10 @@ reaches the rclpy graph; importing this module imports rclpy."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from typing import Any
 
 from roc.ros.graph import Graph
-from roc.ros.protocol import DEFAULT_SPIN_TIME
+from roc.ros.protocol import DEFAULT_SPIN_TIME, Events
 from roc.ros.streams import run_on
 
 
@@ -33,7 +32,7 @@ def query(method: str, params: dict[str, Any], spin_time: float | None) -> Any:
 
 
 def stream(method: str, params: dict[str, Any], node_name: str | None = None,
-           **in_process: Any) -> Iterator[dict[str, Any]]:
+           **in_process: Any) -> Events:
     """A stream without the daemon: its endpoint on a fresh participant of this process, on a node
     named ``node_name`` (default: a hidden one)."""
     graph = Graph(node_name)
@@ -43,6 +42,6 @@ def stream(method: str, params: dict[str, Any], node_name: str | None = None,
         graph.close()
 
 
-def stream_on(graph: Graph, method: str, params: dict[str, Any]) -> Iterator[dict[str, Any]]:
+def stream_on(graph: Graph, method: str, params: dict[str, Any]) -> Events:
     """A stream on a participant made by discovered_graph."""
     return run_on(graph, method, params)

@@ -15,14 +15,14 @@ import math
 import sys
 from collections.abc import Callable, Iterable
 from functools import cache, partial
-from typing import Any
+from typing import Any, cast
 
 import yaml
 from rosidl_parser import definition as idl
 
 from roc.errors import UsageError
 from roc.render import to_message_yaml
-from roc.ros.types import interface_kind, resolve_type, type_name
+from roc.ros.types import InterfaceClass, interface_kind, resolve_type, type_name
 
 
 class MessageValueError(UsageError):
@@ -45,17 +45,17 @@ Fields = tuple[tuple[str, Any], ...]
 
 
 @cache
-def fields(cls: type) -> Fields:
+def fields(cls: InterfaceClass) -> Fields:
     """``(name, rosidl definition)`` of each field of a message class, in definition order."""
     return tuple(zip(cls.get_fields_and_field_types(), cls.SLOT_TYPES))
 
 
 @cache
-def _field_map(cls: type) -> dict[str, Any]:
+def _field_map(cls: InterfaceClass) -> dict[str, Any]:
     return dict(fields(cls))
 
 
-def _nested_class(namespaced: idl.NamespacedType) -> type:
+def _nested_class(namespaced: idl.NamespacedType) -> InterfaceClass:
     return resolve_type("/".join(namespaced.namespaced_name()))
 
 
@@ -89,7 +89,7 @@ def message_to_dict(msg: Any, *, no_arr: bool = False, no_str: bool = False,
                     truncate_length: int | None = None) -> dict[str, Any]:
     """The message's fields in definition order, as ``ros2 topic echo`` shows them."""
     return {name: _to_data(getattr(msg, name), slot, no_arr, no_str, truncate_length)
-            for name, slot in fields(type(msg))}
+            for name, slot in fields(msg.__class__)}
 
 
 def _is_numpy(value: Any, kind: str) -> bool:
@@ -113,7 +113,7 @@ def value_to_data(value: Any, *, no_arr: bool = False, no_str: bool = False,
 
 def _to_data(value: Any, slot: Any, no_arr: bool, no_str: bool, limit: int | None) -> Any:
     if isinstance(value, (bool, int, float)):
-        return value.item() if _is_numpy(value, "generic") else value
+        return cast(Any, value).item() if _is_numpy(value, "generic") else value  # numpy scalars subclass float
     if isinstance(value, str):
         if no_str:
             return f"<string length: <{len(value)}>>"
@@ -153,7 +153,7 @@ def message_to_csv(msg: Any, *, no_arr: bool = False, no_str: bool = False,
                    truncate_length: int | None = None) -> str:
     """All fields, recursively, separated by commas, as ``ros2 topic echo --csv`` prints them."""
     return _csv_join(_csv(getattr(msg, name), slot, no_arr, no_str, truncate_length)
-                     for name, slot in fields(type(msg)))
+                     for name, slot in fields(msg.__class__))
 
 
 def _csv_join(parts: Iterable[str]) -> str:
@@ -206,7 +206,7 @@ def get_field(msg: Any, path: str) -> Any:
         where = ".".join(names[: depth + 1])
         if not hasattr(type(value), "SLOT_TYPES"):
             raise MessageValueError(f"{where}: '{'.'.join(names[:depth])}' is not a message")
-        known = _field_map(type(value))
+        known = _field_map(value.__class__)
         if name not in known:
             listed = ", ".join(known) or "it has no fields"
             raise MessageValueError(f"{where}: {type_name(value)} has no field '{name}' ({listed})")
@@ -276,7 +276,7 @@ def _show(value: Any) -> str:
 
 
 def _fill(msg: Any, values: Any, path: str, stamps: StampSetters | None) -> None:
-    cls = type(msg)
+    cls = msg.__class__
     if not isinstance(values, dict):
         where = f"{path}: " if path else ""
         raise MessageValueError(f"{where}expected a mapping of {type_name(cls)} fields, got {_show(values)}")
@@ -327,11 +327,11 @@ def _basic(value: Any, typename: str, where: str) -> Any:
             raise MessageValueError(f"{where}: expected {typename} in {low}..{high}, got {_show(value)}")
         return number
     if typename in ("float", "double"):
-        number = _as_float(value)
-        if number is None or (typename == "float" and math.isfinite(number) and abs(number) > FLOAT32_MAX):
+        real = _as_float(value)
+        if real is None or (typename == "float" and math.isfinite(real) and abs(real) > FLOAT32_MAX):
             limit = f" in -{FLOAT32_MAX}..{FLOAT32_MAX}" if typename == "float" else ""
             raise MessageValueError(f"{where}: expected {MSG_NAMES[typename]}{limit}, got {_show(value)}")
-        return number
+        return real
     if typename == "boolean":
         if isinstance(value, bool):
             return value

@@ -18,10 +18,12 @@ _TYPE_CODES = {name: code for code, name in PARAMETER_TYPES.items()}
 def parameter_value(value) -> dict[str, Any]:
     """{type, value} of an rcl_interfaces ParameterValue, the value as plain JSON data."""
     field = VALUE_FIELDS.get(value.type)
-    data = getattr(value, field) if field else None
+    if field is None:
+        return {"type": "not set", "value": None}
+    data = getattr(value, field)
     if field == "byte_array_value":
         data = [b if isinstance(b, int) else ord(b) for b in data]
-    elif field and field.endswith("_array_value"):
+    elif field.endswith("_array_value"):
         data = list(data)
     return {"type": PARAMETER_TYPES.get(value.type, "not set"), "value": data}
 

@@ -5,7 +5,8 @@ discovery variables, discovery timing, name rules and the parameter type names o
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+from collections.abc import Generator, Mapping
+from typing import Any
 
 # The variables that decide what a participant discovers: a daemon serves one set of values.
 DISCOVERY_VARIABLES = ("ROS_DOMAIN_ID", "RMW_IMPLEMENTATION", "ROS_AUTOMATIC_DISCOVERY_RANGE",
@@ -14,6 +15,9 @@ DISCOVERY_VARIABLES = ("ROS_DOMAIN_ID", "RMW_IMPLEMENTATION", "ROS_AUTOMATIC_DIS
 DEFAULT_SPIN_TIME = 3.5
 # A stream sends an event at least this often, so a client can act between messages.
 HEARTBEAT_SECONDS = 0.5
+
+# A stream's events (docs/daemon.md): a generator, so that closing it ends the stream and removes its endpoint.
+Events = Generator[dict[str, Any], None, None]
 
 # rcl_interfaces' ParameterType codes, by the names roc sends on the wire ({"type": ..., "value": ...}).
 PARAMETER_TYPES = {0: "not set", 1: "boolean", 2: "integer", 3: "double", 4: "string", 5: "byte array",

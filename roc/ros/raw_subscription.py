@@ -114,7 +114,7 @@ class RawSubscription:
 
     def take(self, most: int) -> list[tuple[bytes, dict[str, Any]]]:
         """Up to ``most`` messages waiting, oldest first."""
-        taken = []
+        taken: list[tuple[bytes, dict[str, Any]]] = []
         while len(taken) < most:
             info = _Info()
             result = self._rcl.rcl_take_serialized_message(self._handle.pointer, ctypes.byref(self._buffer),
@@ -158,7 +158,8 @@ class Receiver:
         self._wake.trigger_guard_condition()
 
     def _take_all(self) -> None:
-        wait_set, size = None, -1
+        wait_set: Any = None  # an rclpy WaitSet with room for ``size`` subscriptions
+        size = -1
         try:
             while not self._stopping:
                 with self._changed:

@@ -12,7 +12,7 @@ import importlib
 import os
 from functools import cache
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeAlias
 
 from roc.environment import path_list
 from roc.errors import UsageError
@@ -29,6 +29,10 @@ TF_TYPE = "tf2_msgs/msg/TFMessage"  # what /tf and /tf_static carry
 class UnknownTypeError(UsageError):
     """An interface type that is not installed, or a malformed type name."""
 
+
+# A class rosidl generated (a message, service or action, or one of their parts): dynamic, with no
+# type information for a checker, so its attributes (Request, Goal, SLOT_TYPES, ...) are Any.
+InterfaceClass: TypeAlias = Any
 
 def split_type_name(name: str) -> tuple[str, str | None, str]:
     """``pkg/msg/Type`` -> ``(pkg, 'msg', Type)``; ``pkg/Type`` -> ``(pkg, None, Type)``."""
@@ -67,7 +71,7 @@ def _interface_module(package: str, kind: str) -> Any:
     return module if getattr(module, "__file__", None) else None
 
 
-def _lookup(package: str, kind: str, name: str) -> type | None:
+def _lookup(package: str, kind: str, name: str) -> InterfaceClass | None:
     """The class ``name`` of ``package.kind``, including the parts of services and actions that
     their modules do not export (``Fibonacci_Goal``, ``Fibonacci_FeedbackMessage``)."""
     module = _interface_module(package, kind)
@@ -82,7 +86,7 @@ def _lookup(package: str, kind: str, name: str) -> type | None:
 
 
 @cache
-def _resolve(name: str, kind: str | None) -> type:
+def _resolve(name: str, kind: str | None) -> InterfaceClass:
     package, given_kind, short = split_type_name(name)
     kinds = [given_kind] if given_kind else [kind] if kind else list(KINDS)
     for candidate in kinds:
@@ -95,21 +99,21 @@ def _resolve(name: str, kind: str | None) -> type:
     raise UnknownTypeError(_unknown_message(name, package, kinds, short))
 
 
-def resolve_type(name: str, kind: str | None = None) -> type:
+def resolve_type(name: str, kind: str | None = None) -> InterfaceClass:
     """The class of an interface type; ``kind`` (msg, srv, action) also requires that kind and is
     the default for ``pkg/Type``. Raises UnknownTypeError with a hint."""
     return _resolve(name, kind)
 
 
-def message_class(name: str) -> type:
+def message_class(name: str) -> InterfaceClass:
     return resolve_type(name, "msg")
 
 
-def service_class(name: str) -> type:
+def service_class(name: str) -> InterfaceClass:
     return resolve_type(name, "srv")
 
 
-def action_class(name: str) -> type:
+def action_class(name: str) -> InterfaceClass:
     return resolve_type(name, "action")
 
 

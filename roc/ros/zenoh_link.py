@@ -32,7 +32,7 @@ import re
 import threading
 import time
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -149,9 +149,9 @@ class _Topic:
 
 
 class ZenohLink:
-    def __init__(self, domain: int, topics: list[str], include: list[str] = (), exclude: list[str] = (),
-                 everything: bool = False, config: zenoh.Config | None = None, services: list[str] = (),
-                 actions: list[str] = ()) -> None:
+    def __init__(self, domain: int, topics: list[str], include: Sequence[str] = (), exclude: Sequence[str] = (),
+                 everything: bool = False, config: zenoh.Config | None = None, services: Sequence[str] = (),
+                 actions: Sequence[str] = ()) -> None:
         """Carry ``topics`` (and with ``everything`` each topic whose name matches one of ``include``, all
         when empty, and none of ``exclude``), ``services`` and ``actions`` between ROS domain ``domain`` and
         the Zenoh peers ``config`` names, both ways (a service or action is offered by the side with its
@@ -172,9 +172,9 @@ class ZenohLink:
         self.ignored: set[str] = set()  # remote topics not selected, or whose type this side cannot load
         self.lock = threading.Lock()
         self.session = open_session(config or zenoh_config([], []))
-        self.graph = None
-        self.subscribers = []
-        self.tokens = []
+        self.graph: Graph | None = None
+        self.subscribers: list[Any] = []  # zenoh subscribers, each with undeclare()
+        self.tokens: list[zenoh.LivelinessToken] = []
         try:
             # every topic may have publishers on both sides, so the link may both publish and subscribe it
             loop_guard([Route(name, domain, domain) for name in topics] + [Route("*", domain, domain)] * everything)
@@ -195,7 +195,8 @@ class ZenohLink:
         """Stop carrying: the Zenoh session closed, the rclpy context shut down."""
         for subscriber in self.subscribers:  # nothing more comes in
             subscriber.undeclare()
-        for service in [*self.offers.values(), *self.proxies.values()]:
+        services: list[ServiceOffer | ServiceProxy] = [*self.offers.values(), *self.proxies.values()]
+        for service in services:
             service.close()
         if self.graph is not None:
             self.graph.close()
@@ -208,9 +209,14 @@ class ZenohLink:
         return self.everything and self.wanted(topic)
 
     # -- ROS to Zenoh -------------------------------------------------------------------------------
+    def _live_graph(self) -> Graph:
+        """The participant, which exists from the end of __init__ until close."""
+        assert self.graph is not None, "the link is closed"
+        return self.graph
+
     def _scan(self) -> None:
         """Carry out each selected local topic that has a publisher other than a bridge's."""
-        node = self.graph.node
+        node = self._live_graph().node
         for name, types in node.get_topic_names_and_types():
             if name in self.outgoing or not self.selected(name):
                 continue
@@ -225,7 +231,7 @@ class ZenohLink:
             if servers and name in service_types:
                 type_name = service_types[name][0]
                 with self.lock:
-                    self.offers[name] = ServiceOffer(self.session, self.graph, name, type_name, self.errors)
+                    self.offers[name] = ServiceOffer(self.session, self._live_graph(), name, type_name, self.errors)
                 self.tokens.append(self.session.liveliness().declare_token(
                     _announcement(self.zid, name, {"type": type_name})))
                 self.events.put({"event": "bridging", "kind": "service", "direction": "out", "topic": name,
@@ -236,14 +242,16 @@ class ZenohLink:
         incoming = receive_profile(offered)
         reliability, durability = qos_name(incoming)
         reliable = reliability == "reliable"
-        options = {"congestion_control": zenoh.CongestionControl.BLOCK if reliable else zenoh.CongestionControl.DROP,
-                   "reliability": zenoh.Reliability.RELIABLE if reliable else zenoh.Reliability.BEST_EFFORT}
+        congestion = zenoh.CongestionControl.BLOCK if reliable else zenoh.CongestionControl.DROP
+        delivery = zenoh.Reliability.RELIABLE if reliable else zenoh.Reliability.BEST_EFFORT
+        publisher: zenoh.Publisher | zenoh.ext.AdvancedPublisher
         if durability == "transient_local":
             publisher = zenoh.ext.declare_advanced_publisher(
                 self.session, f"{LATCHED_PREFIX}{name}", cache=zenoh.ext.CacheConfig(offered.depth),
-                publisher_detection=True, **options)
+                publisher_detection=True, congestion_control=congestion, reliability=delivery)
         else:
-            publisher = self.session.declare_publisher(f"{VOLATILE_PREFIX}{name}", **options)
+            publisher = self.session.declare_publisher(f"{VOLATILE_PREFIX}{name}", congestion_control=congestion,
+                                                       reliability=delivery)
         header = {"type": type_name, "reliability": reliability, "durability": durability, "depth": offered.depth}
         attachment = zenoh.ZBytes(json.dumps(header).encode())
         topic = _Topic(name, type_name, "out", None)
@@ -251,7 +259,7 @@ class ZenohLink:
         def forward(data: bytes) -> None:
             publisher.put(data, attachment=attachment)
             topic.count += 1
-        topic.endpoint = self.graph.node.create_subscription(message_class(type_name), name, forward, incoming,
+        topic.endpoint = self._live_graph().node.create_subscription(message_class(type_name), name, forward, incoming,
                                                              raw=True)
         self.outgoing[name] = topic
         self.tokens.append(self.session.liveliness().declare_token(_announcement(self.zid, name, header)))
@@ -288,7 +296,7 @@ class ZenohLink:
             if name in self.proxies or name in self.offers:
                 return
             try:
-                self.proxies[name] = ServiceProxy(self.session, self.graph, name, type_name,
+                self.proxies[name] = ServiceProxy(self.session, self._live_graph(), name, type_name,
                                                   f"{LINK_NODE}_{self.domain}_service_{len(self.proxies)}", self.errors)
             except RocError as error:
                 self.errors.append(f"{name}: cannot serve it here: {error}")
@@ -317,7 +325,7 @@ class ZenohLink:
         profile = QoSProfile(depth=header["depth"],
                              reliability=ReliabilityPolicy.get_from_short_key(header["reliability"]),
                              durability=DurabilityPolicy.get_from_short_key(header["durability"]))
-        topic = _Topic(name, header["type"], "in", self.graph.node.create_publisher(cls, name, profile))
+        topic = _Topic(name, header["type"], "in", self._live_graph().node.create_publisher(cls, name, profile))
         self.incoming[name] = topic
         self.events.put({"event": "bridging", "kind": "topic", "direction": "in", "topic": name,
                          "type": header["type"], "domain": self.domain, "reliability": header["reliability"],
@@ -334,7 +342,7 @@ class ZenohLink:
         (messages or calls a second per topic or service and direction), until closed."""
         yield {"event": "session", "zid": self.zid, "domain": self.domain}
         peers: set[str] = set()
-        last, counts = time.monotonic(), {}
+        last, counts = time.monotonic(), dict[str, int]()
         next_scan = 0.0
         while True:
             now = time.monotonic()
@@ -353,7 +361,7 @@ class ZenohLink:
             now = time.monotonic()
             if now - last >= period:
                 rates = {}
-                carried = [(f"{t.name} ({t.direction})", t)
+                carried: list[tuple[str, _Topic | ServiceOffer | ServiceProxy]] = [(f"{t.name} ({t.direction})", t)
                            for t in [*self.outgoing.values(), *self.incoming.values()]]
                 carried += [(f"service {s.name} ({way})", s) for way, services
                             in (("out", self.offers), ("in", self.proxies)) for s in services.values()]

@@ -37,7 +37,8 @@ class ServiceOffer:
             f"{SERVICE_PREFIX}{name}", lambda query: self._workers.submit(self._answer, query), complete=True)
 
     def _answer(self, query: zenoh.Query) -> None:
-        response = call(self._client, deserialize_message(query.payload.to_bytes(), self._cls.Request), CALL_SECONDS)
+        payload = query.payload.to_bytes() if query.payload is not None else b""
+        response = call(self._client, deserialize_message(payload, self._cls.Request), CALL_SECONDS)
         if response is None:
             self.errors.append(f"{self.name}: the server did not answer within {CALL_SECONDS:g} s")
             query.reply_err(b"no response")

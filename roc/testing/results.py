@@ -70,7 +70,10 @@ def _messages(label: str, messages: list[str]) -> list[str]:
 
 def _testcase_details(case) -> str | None:
     """colcon's text for a test case with errors or failures, else None."""
-    errors, failures, outs, errs = [], [], [], []
+    errors: list[str] = []
+    failures: list[str] = []
+    outs: list[str] = []
+    errs: list[str] = []
     for child in case:
         target = {"error": errors, "failure": failures}.get(child.tag)
         if target is not None:
@@ -241,7 +244,7 @@ def package_of(path: str, base: Path) -> str:
 def merged_junit(results: list[Result], base: Path) -> bytes:
     """Every result as one JUnit report: a ``testsuite`` per suite, named ``<package>.<suite>``."""
     summary = summarize(results)
-    root = etree.Element("testsuites", name="roc", **{name: str(getattr(summary, name)) for name in COUNTS})
+    root = etree.Element("testsuites", {"name": "roc", **{name: str(getattr(summary, name)) for name in COUNTS}})
     for result in results:
         package = package_of(result.path, base)
         for suite in result.suites:

@@ -21,7 +21,7 @@ from roc.workspace.package import IGNORE_MARKERS, Package
 
 def _expand(patterns: Iterable[str], root: Path) -> list[str]:
     """Expand shell wildcards (for values that did not go through a shell), keeping directories."""
-    result = []
+    result: list[str] = []
     for pattern in patterns:
         if any(c in pattern for c in "*?["):
             matches = sorted(glob.glob(str(root / pattern)))

@@ -7,6 +7,10 @@ from the discovery cache.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from roc.workspace.manifest import Manifest
 
 CATEGORIES = ("build", "run", "test")
 # Files whose presence makes discovery skip a directory and everything below it.
@@ -30,7 +34,7 @@ class Package:
         self, name: str, path: Path, type: str, dependencies: dict[str, set[str]] | None = None,  # noqa: A002
         hooks: list[str] | None = None, metadata: dict[str, object] | None = None,
         constraints: dict[str, dict[str, str]] | None = None, group_depends: list[str] | None = None,
-        member_of_groups: list[str] | None = None, manifest: Manifest | None = None,  # noqa: F821
+        member_of_groups: list[str] | None = None, manifest: Manifest | None = None,
     ):
         self.name = name
         self.path = path

@@ -26,7 +26,7 @@ SETUP_KEYWORDS = ("name", "version", *REQUIREMENT_CATEGORIES, "extras_require")
 
 @dataclass
 class PythonProject:
-    name: str | None
+    name: str
     version: str | None = None
     maintainers: list[str] = field(default_factory=list)
     dependencies: dict[str, set[str]] = field(default_factory=dict)

@@ -83,9 +83,10 @@ def routes_from_config(path: Path) -> list:
         if set(qos) - SUPPORTED_QOS and any(qos[key] != "auto" for key in set(qos) - SUPPORTED_QOS):
             raise UsageError(f"{where}: qos: {min(set(qos) - SUPPORTED_QOS)}: only 'auto' is supported; "
                              f"roc sets {', '.join(sorted(SUPPORTED_QOS))}")
-        domains = [domain_id(spec.get(key, settings.get(key, 0)), f"{where}: {key}") for key in ("from_domain", "to_domain")]
+        source, target = (domain_id(spec.get(key, settings.get(key, 0)), f"{where}: {key}")
+                          for key in ("from_domain", "to_domain"))
         remap = spec.get("remap")
-        route = Route(absolute(name), *domains, spec.get("type"), remap and absolute(remap),
+        route = Route(absolute(name), source, target, spec.get("type"), remap and absolute(remap),
                       {k: v for k, v in qos.items() if k in SUPPORTED_QOS}, SECTIONS[section])
         if spec.get("reversed"):
             route = route.swapped()

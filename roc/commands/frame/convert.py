@@ -7,7 +7,7 @@ import argparse
 import math
 
 from roc.errors import UsageError
-from roc.frames.transform import AXES, Transform, normalized
+from roc.frames.transform import AXES, Transform, normalized, vector
 from roc.render import render
 
 
@@ -37,7 +37,7 @@ def _parsed_transform(text: str, degrees: bool, axes: str) -> Transform:
         angles = [math.radians(v) for v in values[3:]] if degrees else values[3:]
         return Transform.from_euler(values[:3], angles, axes)
     if len(values) == 7:
-        return Transform(tuple(values[:3]), _unit(values[3:], f"--transform '{text}'"))
+        return Transform(vector(values[:3]), _unit(values[3:], f"--transform '{text}'"))
     raise UsageError(f"--transform '{text}': expected 6 numbers (x y z roll pitch yaw) or 7 (x y z qx qy qz qw), "
                      f"got {len(values)}")
 

@@ -7,6 +7,7 @@ import argparse
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 from roc.cli.options import add_graph_arguments, add_qos_arguments, qos_options
 from roc.errors import UsageError
@@ -69,7 +70,7 @@ def run(args: argparse.Namespace) -> int:
               "qos": qos_options(args), "rate": args.rate, "times": times,
               "wait": wait if wait is not None else 1 if times else 0,
               "max_wait": args.max_wait_time_secs, "keep_alive": args.keep_alive}
-    local = {}
+    local: dict[str, Any] = {}
     if stamps:  # header: auto / stamp: now, set anew before each message: published from this process
         local["prepare"] = lambda: _restamp(message, stamps)
     if args.node_name:
