@@ -49,7 +49,7 @@ class SqliteFile:
         if not path.is_file():
             raise BagError(f"{path}: no such file")
         try:
-            self._db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+            self._db = sqlite3.connect(f"file:{path}?mode=ro", uri=True, check_same_thread=False)
             tables = {row[0] for row in self._db.execute("SELECT name FROM sqlite_master WHERE type='table'")}
         except sqlite3.DatabaseError as error:
             raise BagError(f"{path}: not a sqlite3 bag ({error})") from None
