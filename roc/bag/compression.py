@@ -32,7 +32,18 @@ def decompress_file(path: Path, target: Path) -> Path:
     """``path`` (a ``.zstd`` file) decompressed to ``target``."""
     try:
         with open(path, "rb") as source, open(target, "wb") as sink:
-            zstandard.ZstdDecompressor().copy_stream(source, sink)
+            inside = False  # in a frame whose end has not come yet
+            decompressor = zstandard.ZstdDecompressor().decompressobj()
+            for block in iter(lambda: source.read(1 << 20), b""):
+                while block:
+                    inside = True
+                    sink.write(decompressor.decompress(block))
+                    block = b""
+                    if decompressor.eof:  # a frame ended; what follows is the next frame
+                        block, inside = decompressor.unused_data, False
+                        decompressor = zstandard.ZstdDecompressor().decompressobj()
+            if inside:
+                raise BagError(f"{path}: not a whole zstd file (it ends inside a frame: truncated?)")
     except OSError as error:
         raise BagError(f"{path}: cannot read it ({error.strerror})") from None
     except zstandard.ZstdError as error:
@@ -54,7 +65,7 @@ class MessageDecompressor:
         self._source = source
 
     def __call__(self, data: bytes) -> bytes:
-        try:
-            return self._decompressor.decompress(data)
+        try:  # through a decompressobj: a frame need not say its content size
+            return self._decompressor.decompressobj().decompress(data)
         except zstandard.ZstdError as error:
             raise BagError(f"{self._source}: a message is not a zstd frame ({error})") from None

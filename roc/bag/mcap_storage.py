@@ -35,8 +35,9 @@ PRESETS = {  # rosbag2_storage_mcap's preset profiles
     "zstd_fast": "Use Zstd chunk compression on Fastest level.",
     "zstd_small": "Use Zstd chunk compression on Slowest level, for smallest file size.",
 }
+MESSAGE_OVERHEAD = 31  # bytes of an MCAP message record besides its data (opcode, length, header)
 # What a damaged file raises while it is read.
-READ_ERRORS = (McapError, struct.error, ValueError, EOFError, KeyError, IndexError, MemoryError)
+READ_ERRORS = (McapError, struct.error, ValueError, EOFError, KeyError, IndexError, MemoryError, OSError)
 
 
 def _topic(channel: Channel, schema: Schema | None) -> Topic:
@@ -71,6 +72,11 @@ class McapFile:
             self._summary = self._reader.get_summary()
         except READ_ERRORS:
             self._summary = None  # not closed: no footer, or a damaged summary
+            try:
+                self._reader.get_header()
+            except READ_ERRORS:
+                self._file.close()
+                raise BagError(f"{path}: a damaged or truncated MCAP file (not even its header is whole)") from None
 
     def close(self) -> None:
         self._file.close()
@@ -228,6 +234,8 @@ class McapWriter:
         self._writer.start(profile="ros2", library=f"roc {__version__}")
         self._schemas: dict[str, int] = {}
         self._channels: dict[str, int] = {}
+        self._chunk_bytes = 0  # messages added since the file last grew (the chunk being filled)
+        self._file_bytes = 0
 
     def add_topic(self, topic: Topic, definition: Definition) -> None:
         if topic.name in self._channels:
@@ -243,10 +251,14 @@ class McapWriter:
 
     def write(self, topic: str, data: bytes, log_time: int, publish_time: int) -> None:
         self._writer.add_message(self._channels[topic], log_time, data, publish_time)
+        if self._file.tell() != self._file_bytes:
+            self._file_bytes, self._chunk_bytes = self._file.tell(), 0
+        else:
+            self._chunk_bytes += len(data) + MESSAGE_OVERHEAD
 
     def size(self) -> int:
-        """Bytes written so far (the chunk being filled not counted)."""
-        return self._file.tell()
+        """Bytes written so far, the chunk being filled included."""
+        return self._file.tell() + self._chunk_bytes
 
     def close(self, serialized_metadata: str) -> None:
         """Write rosbag2's metadata record, the summary and the footer."""

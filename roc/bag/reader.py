@@ -144,8 +144,9 @@ class Bag:
 
     @property
     def incomplete_files(self) -> list[Path]:
-        """Files that were not closed (their recording was killed)."""
-        return [p for p in self.files if not getattr(self.file(p), "complete", True)]
+        """Files that were not closed (their recording was killed); a compressed file was closed before."""
+        return [p for p in self.files
+                if not p.name.endswith(compression.SUFFIX) and not getattr(self.file(p), "complete", True)]
 
     def file(self, path: Path) -> StorageFile:
         """The opened storage file ``path`` (decompressed into a temporary directory first if .zstd)."""
