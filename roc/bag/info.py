@@ -93,7 +93,7 @@ def event_kind(data: bytes) -> tuple[int, bytes, int] | None:
     if len(data) < 44:
         return None
     order = "<" if data[1] & 1 else ">"
-    return data[4], bytes(data[20:36]), struct.unpack(order + "q", data[36:44])[0]
+    return data[4], bytes(data[16:32]), struct.unpack(order + "q", data[36:44])[0]
 
 
 def service_counts(bag: Bag) -> dict[str, tuple[int, int]]:

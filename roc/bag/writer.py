@@ -71,6 +71,17 @@ def _disk_error(error: OSError, path: Path) -> BagError:
     return BagError(f"{path}: cannot write ({error.strerror})")
 
 
+def _failing(method):
+    """A BagWriter method after whose failure the bag's metadata is taken from its files."""
+    def wrapper(self, *args, **kwargs):
+        try:
+            return method(self, *args, **kwargs)
+        except BagError:
+            self.failed = True
+            raise
+    return wrapper
+
+
 class BagWriter:
     """A bag being written into the new directory ``uri``."""
 
@@ -92,6 +103,8 @@ class BagWriter:
         self._file_start = self._file_end = self._file_count = 0
         self._compress = (compression.MessageCompressor() if options.compression_mode == "message" else None)
         self.closed = False
+        self.failed = False  # a write failed: what the files hold may be less than what was written
+        self._file = self._open_file()  # at once, as rosbag2: a recording in progress is a readable bag
 
     @property
     def message_count(self) -> int:
@@ -122,6 +135,7 @@ class BagWriter:
             except OSError as error:
                 raise _disk_error(error, self._file.path) from None
 
+    @_failing
     def write(self, topic: str, data: bytes, log_time: int, publish_time: int = 0) -> None:
         """One message of a topic added before; splits the bag first when a limit is reached."""
         if self._file is None:
@@ -155,6 +169,7 @@ class BagWriter:
             except OSError as error:
                 raise _disk_error(error, self._file.path) from None
 
+    @_failing
     def split(self) -> None:
         """Close the current file (compressing it in ``file`` mode); the next message opens a new one."""
         if self._file is None:
@@ -189,18 +204,25 @@ class BagWriter:
             compression_mode=self.options.compression_mode if compressed else "",
             custom_data=dict(self.options.custom_data), ros_distro=ros_distro())
 
+    def _readable_metadata(self) -> BagMetadata:
+        """After a failed write: the metadata of what the files really hold (read back from them)."""
+        from roc.bag.reader import Bag
+
+        try:
+            with Bag(self.uri, self.options.storage) as bag:
+                return bag.metadata
+        except BagError:
+            return self.metadata()
+
     def close(self) -> BagMetadata:
-        """Close the last file and write metadata.yaml. A bag in which nothing was written still gets
-        its (empty) file, as rosbag2's."""
+        """Close the last file and write metadata.yaml."""
         if self.closed:
             return self.metadata()
         self.closed = True
         try:
-            if self._file is None and not self._paths:
-                self._file = self._open_file()
             self.split()
         finally:
-            metadata = self.metadata()
+            metadata = self._readable_metadata() if self.failed else self.metadata()
             try:
                 write_metadata(self.uri, metadata)
             except OSError as error:

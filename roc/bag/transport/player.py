@@ -49,6 +49,7 @@ class PlayOptions:
     playback_until: int = -1  # ns since the epoch; negative: to the end
     read_ahead: int = 1000
     start_paused: bool = False
+    wait_for_all_acked: int = -1  # ms to wait at the end for reliable subscribers to have it all (0: forever)
 
 
 @dataclass
@@ -226,10 +227,21 @@ class Player:
                         break
                     if not options.loop or self._stopping:
                         break
+                if options.wait_for_all_acked >= 0:
+                    self._wait_for_acks(publishers.values())
             finally:
                 self.stop()
                 graph.close()
         return PlayResult(published, lateness, skipped)
+
+    def _wait_for_acks(self, publishers) -> None:
+        from rclpy.duration import Duration
+
+        timeout = Duration(seconds=self.options.wait_for_all_acked / 1000 if self.options.wait_for_all_acked
+                           else 10 ** 9)
+        for publisher in publishers:
+            if not self._stopping and not publisher.wait_for_all_acked(timeout):
+                self._warn(f"{publisher.topic_name}: not every subscriber acknowledged every message in time")
 
     def _play_once(self, bag: Bag, publishers: dict[str, Any], start: int, end: int | None,
                    published: dict[str, int], lateness: list[int]) -> bool:

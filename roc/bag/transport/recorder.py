@@ -31,6 +31,8 @@ from roc.ros.types import UnknownTypeError, message_class
 CLOCK_TOPIC = "/clock"
 CLOCK_KEY = ("clock",)  # the Receiver key of the /clock subscription of --use-sim-time
 FLUSH_SECONDS = 0.5  # a sqlite3 bag commits at least this often
+DRAIN_QUIET_SECONDS = 0.1
+DRAIN_SECONDS = 2.0
 
 
 @dataclass
@@ -150,6 +152,16 @@ class Recorder:
             writer.write(key, data, log_time, info["source_timestamp"])
             stats.written += 1
 
+    def _drain(self, receiver: Receiver, writer: BagWriter) -> None:
+        """Write what arrived before the stop: until nothing came for DRAIN_QUIET_SECONDS (the
+        Receiver takes a message as soon as rcl has it), at most DRAIN_SECONDS."""
+        deadline = time.monotonic() + DRAIN_SECONDS
+        while time.monotonic() < deadline:
+            batch = receiver.batch(DRAIN_QUIET_SECONDS)
+            if not batch:
+                return
+            self._write(writer, batch)
+
     def run(self) -> Result:
         options = self.options
         writer = BagWriter(options.uri, options.write)
@@ -173,7 +185,7 @@ class Recorder:
                     writer.flush()
                     next_flush = now + FLUSH_SECONDS
                 self._write(writer, receiver.batch(min(0.05, options.polling_interval)))
-            self._write(writer, receiver.batch(0))  # what was taken before the stop
+            self._drain(receiver, writer)
         except DiskFull as full:
             error = str(full)
         except RocError as failure:

@@ -63,6 +63,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="play up to this bag time, in seconds since the epoch (negative: to the end)")
     parser.add_argument("--read-ahead-queue-size", type=int, default=1000, metavar="N",
                         help="messages read ahead of playback (default: 1000)")
+    parser.add_argument("--wait-for-all-acked", type=int, default=-1, metavar="MS",
+                        help="at the end, wait up to MS ms until reliable subscribers acknowledged every message "
+                             "(0: as long as it takes; default: do not wait)")
     parser.add_argument("-p", "--start-paused", action="store_true", help="start paused (space resumes)")
     parser.add_argument("--disable-keyboard-controls", action="store_true", help="no keyboard controls")
 
@@ -115,7 +118,8 @@ def run(args: argparse.Namespace) -> int:
         selection=_selection(args), remaps=_remaps(args.remap), overrides=overrides, start_offset=args.start_offset,
         delay=args.delay, playback_duration=args.playback_duration,
         playback_until=int(args.playback_until_sec * 1e9) if args.playback_until_sec >= 0 else -1,
-        read_ahead=args.read_ahead_queue_size, start_paused=args.start_paused),
+        read_ahead=args.read_ahead_queue_size, start_paused=args.start_paused,
+        wait_for_all_acked=args.wait_for_all_acked),
         report=lambda line: print_text(line + "\n"),
         warn=lambda line: print_text(f"roc: warning: {line}\n", sys.stderr))
     for number in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
