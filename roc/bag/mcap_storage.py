@@ -230,7 +230,8 @@ class McapWriter:
         compression = CompressionType.ZSTD if preset.startswith("zstd") else CompressionType.NONE
         self._writer = Writer(self._file,  # type: ignore[arg-type]  # a stream is anything with write and tell
                               chunk_size=4 * 1024 * 1024 if preset == "zstd_small" else CHUNK_SIZE,
-                              compression=compression, use_chunking=chunked, enable_crcs=preset != "fastwrite")
+                              compression=compression, use_chunking=chunked,
+                              enable_crcs=preset == "zstd_small")  # rosbag2 writes no chunk CRCs but there
         self._writer.start(profile="ros2", library=f"roc {__version__}")
         self._schemas: dict[str, int] = {}
         self._channels: dict[str, int] = {}

@@ -249,15 +249,15 @@ class Player:
         if self.options.delay > 0:
             with self._changed:
                 self._changed.wait_for(lambda: self._stopping, self.options.delay)
-        with self._changed:
-            self._anchor(start)
         ready: queue.Queue = queue.Queue(maxsize=max(1, self.options.read_ahead))
         reader = threading.Thread(target=self._read, args=(bag, list(publishers), start, end, ready),
                                   name="roc-bag-reader", daemon=True)
         reader.start()
         try:
+            item = ready.get()  # the clock starts once the first message is read (opening files takes time)
+            with self._changed:
+                self._anchor(start)
             while True:
-                item = ready.get()
                 if item is None:
                     return True
                 if isinstance(item, Exception):
@@ -268,6 +268,7 @@ class Player:
                 if not self._paused:
                     lateness.append(time.perf_counter_ns() - self._due(item.log_time))
                 published[item.topic] = published.get(item.topic, 0) + 1
+                item = ready.get()
         finally:
             if reader.is_alive():
                 self._stopping_reader(ready)
