@@ -63,7 +63,8 @@ def _cpu(process: subprocess.Popen) -> float:
 
 
 def _load() -> str:
-    return "load average %.2f %.2f %.2f" % os.getloadavg()
+    one, five, fifteen = os.getloadavg()
+    return f"load average {one:.2f} {five:.2f} {fifteen:.2f}"
 
 
 def record(name: str, publisher: list, topic: str, seconds: float, control_type: str) -> None:
