@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
-"""The minimal rclpy subscriber of dataplane_bench.py and bridge_bench.py: counts std_msgs/String
-messages on TOPIC (reliable, depth 1000) until SIGINT, then prints the count as JSON. ``latency``:
+"""The minimal rclpy subscriber of dataplane_bench.py, bridge_bench.py and bag_bench.py: counts
+std_msgs/String messages (or ``type=pkg/msg/Type``'s) on TOPIC (reliable, depth 1000) until SIGINT,
+then prints the count as JSON. ``latency``:
 also each message's age on arrival (its data is its publication time, paced_publisher.py ``stamped``),
 as the median and 99th percentile in milliseconds. ``events``: spin with rclpy's C++ EventsExecutor
 (a far cheaper receiver, so that it does not limit what it measures).
 
-    python bench/counting_subscriber.py TOPIC [latency] [events]
+    python bench/counting_subscriber.py TOPIC [latency] [events] [type=pkg/msg/Type]
 """
 
 from __future__ import annotations
@@ -32,7 +33,12 @@ def main() -> None:
         count[0] += 1
         if timed:
             ages.append((time.time_ns() - int(message.data)) / 1e6)
-    node.create_subscription(String, sys.argv[1], received, QoSProfile(depth=1000))
+    message_type = String
+    for argument in sys.argv[2:]:
+        if argument.startswith("type="):
+            package, kind, name = argument[5:].split("/")
+            message_type = getattr(__import__(f"{package}.{kind}", fromlist=[name]), name)
+    node.create_subscription(message_type, sys.argv[1], received, QoSProfile(depth=1000))
     stop = []
     signal.signal(signal.SIGINT, lambda *_: stop.append(True))
     if "events" in sys.argv[2:]:

@@ -43,6 +43,12 @@ def interface_packages() -> list[str]:
     return sorted(_resources("rosidl_interfaces"))
 
 
+def package_share(package: str) -> Path | None:
+    """``share/<package>`` of the first prefix that registers the package, or None."""
+    prefix = _resources("packages").get(package)
+    return prefix / "share" / package if prefix is not None else None
+
+
 def package_interfaces(package: str | None = None) -> dict[str, dict[str, list[str]]]:
     """{package: {"msg": [names], "srv": [...], "action": [...]}}, hidden ones (with '_') left out."""
     registered = _resources("rosidl_interfaces")

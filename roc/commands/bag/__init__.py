@@ -1,0 +1,1 @@
+"""roc bag: record, play, inspect and convert rosbag2 bags (MCAP and sqlite3)."""

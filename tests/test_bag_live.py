@@ -1,0 +1,288 @@
+"""roc bag record and play on a live graph (real rclpy nodes in subprocesses): recordings read back
+byte for byte, record -> play -> record round trips of every test_msgs type, topics found late, QoS
+adapted, services, keyboard control, crashes (SIGKILL, a full disk) and Ctrl+C."""
+
+from __future__ import annotations
+
+import os
+import pty
+import resource
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+from bag_helpers import TEST_MSGS, filled, load
+from build_helpers import BIN, stop_process
+from graph_helpers import graph_env, read_line, start_nodes
+
+from roc.bag.reader import Bag
+
+pytestmark = pytest.mark.slow
+NODE = Path(__file__).resolve().parent / "bag_node.py"
+TYPES = [f"test_msgs/msg/{name}" for name in TEST_MSGS]
+
+
+def start(args: list[str], env: dict, cwd: Path, **kwargs) -> subprocess.Popen:
+    return subprocess.Popen(args, env=env, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            **kwargs)
+
+
+def roc_process(*args: str, env: dict, cwd: Path, **kwargs) -> subprocess.Popen:
+    return start([str(BIN / "roc"), *args], env, cwd, **kwargs)
+
+
+def wait_for_line(process: subprocess.Popen, wanted: str, timeout: float = 30) -> list[str]:
+    """Lines of stdout up to one containing ``wanted``; fails if the process ends or stays silent."""
+    seen = []
+    deadline = time.monotonic() + timeout
+    while True:
+        line = read_line(process, max(0.1, deadline - time.monotonic()))
+        assert line, f"no line with {wanted!r} (process ended or timed out); saw {seen}"
+        seen.append(line)
+        if wanted in line:
+            return seen
+
+
+def wait_subscribed(recorder: subprocess.Popen, topics: list[str], timeout: float = 30) -> None:
+    pending = {f"Subscribed to topic '{t}'" for t in topics}
+    deadline = time.monotonic() + timeout
+    while pending:
+        line = read_line(recorder, max(0.1, deadline - time.monotonic()))
+        assert line, f"recorder never subscribed to {pending}"
+        pending.discard(line.strip())
+
+
+def interrupt(process: subprocess.Popen, timeout: float = 30) -> str:
+    """Ctrl+C a recorder or player; returns the rest of its stdout."""
+    process.send_signal(signal.SIGINT)
+    rest = []
+    while (line := read_line(process, timeout)) not in ("", None):
+        rest.append(line)
+    assert process.wait(timeout=timeout) == 0, process.stderr.read()
+    return "".join(rest)
+
+
+def messages(bag_path: Path) -> dict[str, list[bytes]]:
+    found: dict[str, list[bytes]] = {}
+    with Bag(bag_path) as bag:
+        for message in bag.messages():
+            found.setdefault(message.topic, []).append(message.data)
+    return found
+
+
+def play_when_recorder_listens(bag: Path, recorder: subprocess.Popen, topics: list[str], env: dict, cwd: Path,
+                               *options: str) -> str:
+    """Play ``bag`` started paused on a terminal, press space once the recorder subscribed to every
+    topic, and return the player's output when it ends."""
+    controller, terminal = pty.openpty()
+    player = start([str(BIN / "roc"), "bag", "play", "-p", "--wait-for-all-acked", "10000", *options, str(bag)],
+                   env, cwd, stdin=terminal)
+    os.close(terminal)
+    try:
+        wait_for_line(player, "Paused")
+        wait_subscribed(recorder, topics)
+        os.write(controller, b" ")
+        output = []
+        while (line := read_line(player, 60)) not in ("", None):
+            output.append(line)
+        assert player.wait(timeout=60) == 0, player.stderr.read()
+        return "".join(output)
+    finally:
+        os.close(controller)
+        stop_process(player)
+
+
+def test_record_play_record_round_trip_of_every_test_msgs_type(tmp_path):
+    env = graph_env(32, tmp_path)
+    topics = [f"/{name.lower()}" for name in TEST_MSGS]
+    first = roc_process("bag", "record", *topics, "-o", "first", env=env, cwd=tmp_path)
+    node = start([sys.executable, str(NODE), "publish", "5", "20", *TYPES], env, tmp_path)
+    try:
+        wait_subscribed(first, topics)
+        wait_for_line(node, "done", timeout=60)
+        summary = interrupt(first)
+    finally:
+        stop_process(node)
+        stop_process(first)
+    assert "Lost messages: 0" in summary
+    from rclpy.serialization import deserialize_message
+
+    recorded = messages(tmp_path / "first")
+    assert {topic: [deserialize_message(data, load(f"test_msgs/msg/{n}")) for data in recorded[topic]]
+            for n in TEST_MSGS for topic in [f"/{n.lower()}"]} == {
+        f"/{n.lower()}": [filled(load(f"test_msgs/msg/{n}"), seed) for seed in range(5)] for n in TEST_MSGS}
+
+    second = roc_process("bag", "record", *topics, "-o", "second", "-s", "sqlite3", env=env, cwd=tmp_path)
+    try:
+        played = play_when_recorder_listens(tmp_path / "first", second, topics, env, tmp_path)
+        assert f"Played {5 * len(TEST_MSGS)} messages on {len(TEST_MSGS)} topics" in played
+        interrupt(second)
+    finally:
+        stop_process(second)
+    assert messages(tmp_path / "second") == recorded  # byte-identical CDR, every type, in order
+    with Bag(tmp_path / "second") as bag:
+        assert bag.storage == "sqlite3" and all(t.offered_qos_profiles for t in bag.topics())
+
+
+def test_late_topics_qos_and_selection(tmp_path):
+    env = graph_env(33, tmp_path)
+    recorder = roc_process("bag", "record", "-a", "-x", "ignored", "-o", "bag", env=env, cwd=tmp_path)
+    nodes = []
+    try:
+        wait_for_line(recorder, "Listening for topics")
+        nodes = start_nodes([{"name": "late", "publishers": [
+            {"topic": "latched", "type": "std_msgs/msg/String", "durability": "transient_local", "depth": 1,
+             "values": {"data": "kept"}},
+            {"topic": "fast", "type": "std_msgs/msg/String", "reliability": "best_effort", "values": {"data": "f"},
+             "rate_hz": 50},
+            {"topic": "ignored_topic", "type": "std_msgs/msg/String", "values": {"data": "x"}, "rate_hz": 50},
+            {"topic": "_hidden", "type": "std_msgs/msg/String", "values": {"data": "x"}, "rate_hz": 50}]}], env)
+        wait_subscribed(recorder, ["/latched", "/fast"])
+        with Bag(tmp_path / "bag") as partial:  # a recording in progress is readable
+            assert partial.metadata_missing
+        time.sleep(0.5)  # let /fast deliver a few messages
+        interrupt(recorder)
+    finally:
+        for node in nodes:
+            stop_process(node)
+        stop_process(recorder)
+    with Bag(tmp_path / "bag") as bag:
+        names = {t.name for t in bag.topics()}
+        assert {"/latched", "/fast"} <= names and not {"/ignored_topic", "/_hidden"} & names
+        latched, fast = bag.metadata.topic("/latched"), bag.metadata.topic("/fast")
+        assert latched.offered_qos_profiles[0]["durability"] == "transient_local"
+        assert fast.offered_qos_profiles[0]["reliability"] == "best_effort"
+        assert latched.type_description_hash.startswith("RIHS01_")
+    found = messages(tmp_path / "bag")
+    assert len(found["/latched"]) == 1 and found["/fast"]  # transient local: the message sent before
+
+
+def test_services_are_recorded_with_request_and_response_counts(tmp_path):
+    env = graph_env(34, tmp_path)
+    node = start([sys.executable, str(NODE), "service", "4"], env, tmp_path, stdin=subprocess.PIPE)
+    recorder = roc_process("bag", "record", "--all-services", "-o", "bag", env=env, cwd=tmp_path)
+    try:
+        assert read_line(node, 30).strip() == "ready"
+        wait_subscribed(recorder, ["/toggle/_service_event"])
+        node.stdin.write("go\n")
+        node.stdin.flush()
+        wait_for_line(node, "done")
+        interrupt(recorder)
+    finally:
+        stop_process(node)
+        stop_process(recorder)
+    info = subprocess.run([str(BIN / "roc"), "bag", "info", "-v", str(tmp_path / "bag")], capture_output=True,
+                          text=True, env=env)
+    assert "Service:           1" in info.stdout
+    assert ("Service: /toggle | Type: std_srvs/srv/SetBool | Request Count: 4 | Response Count: 4 | "
+            "Serialization Format: cdr") in info.stdout
+    plain = subprocess.run([str(BIN / "roc"), "bag", "info", str(tmp_path / "bag")], capture_output=True, text=True,
+                           env=env)
+    assert "Service: /toggle | Type: std_srvs/srv/SetBool | Event Count: 8 |" in plain.stdout  # received, sent
+
+
+def _big_talker(env: dict) -> list[subprocess.Popen]:
+    return start_nodes([{"name": "big", "publishers": [
+        {"topic": "big", "type": "std_msgs/msg/String", "values": {"data": "x" * 20000}, "rate_hz": 100}]}], env)
+
+
+def _wait_for_size(path: Path, size: int, timeout: float = 60) -> None:
+    deadline = time.monotonic() + timeout
+    while not (path.exists() and path.stat().st_size >= size):
+        assert time.monotonic() < deadline, f"{path} never reached {size} bytes"
+        time.sleep(0.1)
+
+
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_sigkill_loses_at_most_the_last_chunk_and_reindex_recovers(tmp_path, storage):
+    env = graph_env(35, tmp_path)
+    nodes = _big_talker(env)
+    recorder = roc_process("bag", "record", "/big", "-o", "bag", "-s", storage, env=env, cwd=tmp_path)
+    try:
+        wait_subscribed(recorder, ["/big"])
+        extension = ".mcap" if storage == "mcap" else ".db3"
+        _wait_for_size(tmp_path / "bag" / f"bag_0{extension}", 3 * 768 * 1024)
+        recorder.kill()
+        recorder.wait()
+    finally:
+        for node in nodes:
+            stop_process(node)
+        stop_process(recorder)
+    bag = tmp_path / "bag"
+    assert not (bag / "metadata.yaml").exists()
+    result = subprocess.run([str(BIN / "roc"), "bag", "reindex", str(bag)], capture_output=True, text=True, env=env)
+    assert result.returncode == 0, result.stderr
+    metadata = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    kept = metadata["message_count"]
+    assert kept >= 2 * 768 * 1024 // 20000  # every chunk written whole before the kill
+    from rosbags.rosbag2 import Reader
+
+    with Reader(bag) as reader:
+        assert sum(1 for _ in reader.messages()) == kept
+
+
+def test_ctrl_c_writes_metadata_and_a_full_disk_stops_cleanly(tmp_path):
+    env = graph_env(35, tmp_path)
+    nodes = _big_talker(env)
+    try:
+        recorder = roc_process("bag", "record", "/big", "-o", "interrupted", env=env, cwd=tmp_path)
+        wait_subscribed(recorder, ["/big"])
+        _wait_for_size(tmp_path / "interrupted" / "interrupted_0.mcap", 768 * 1024)
+        summary = interrupt(recorder)
+        metadata = yaml.safe_load((tmp_path / "interrupted" / "metadata.yaml").read_text())
+        assert metadata["rosbag2_bagfile_information"]["message_count"] > 0
+        assert "Lost messages: 0" in summary
+
+        def small_disk() -> None:  # files may not grow past 2 MB: writes past it fail as on a full disk
+            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+            resource.setrlimit(resource.RLIMIT_FSIZE, (2 * 2**20, 2 * 2**20))
+
+        full = roc_process("bag", "record", "/big", "-o", "full", env=env, cwd=tmp_path, preexec_fn=small_disk)
+        assert full.wait(timeout=120) == 1
+        errors = full.stderr.read()
+        assert "the disk is full" in errors and "Traceback" not in errors
+    finally:
+        for node in nodes:
+            stop_process(node)
+    with Bag(tmp_path / "full") as bag:
+        assert bag.metadata.message_count > 0 and sum(1 for _ in bag.messages()) == bag.metadata.message_count
+
+
+def test_play_options_select_rename_cut_and_clock(tmp_path):
+    """--topics, --remap, --start-offset, --playback-duration and --clock on a bag of two 100 Hz topics."""
+    from rclpy.serialization import serialize_message
+    from std_msgs.msg import String
+
+    from roc.bag.definitions import definition
+    from roc.bag.metadata import Topic
+    from roc.bag.qos import default_profile
+    from roc.bag.writer import BagWriter, WriteOptions
+
+    writer = BagWriter(tmp_path / "source", WriteOptions())
+    for name in ("/a", "/b"):
+        writer.add_topic(Topic(name, "std_msgs/msg/String", "cdr", [default_profile()]),
+                         definition("std_msgs/msg/String"))
+    start_ns = 1_700_000_000_000_000_000
+    for index in range(100):
+        for name in ("/a", "/b"):
+            writer.write(name, serialize_message(String(data=f"{name} {index}")), start_ns + index * 10_000_000)
+    writer.close()
+    env = graph_env(33, tmp_path)
+    recorder = roc_process("bag", "record", "/renamed", "/clock", "-o", "out", env=env, cwd=tmp_path)
+    try:
+        output = play_when_recorder_listens(tmp_path / "source", recorder, ["/renamed", "/clock"], env, tmp_path,
+                                            "--topics", "/a", "--remap", "/a:=/renamed", "--start-offset", "0.2",
+                                            "--playback-duration", "0.5", "--clock", "100")
+        assert "Played 51 messages on 1 topics" in output
+        interrupt(recorder)
+    finally:
+        stop_process(recorder)
+    found = messages(tmp_path / "out")
+    from rclpy.serialization import deserialize_message
+
+    assert [deserialize_message(d, String).data for d in found["/renamed"]] == [f"/a {i}" for i in range(20, 71)]
+    assert found["/clock"]
