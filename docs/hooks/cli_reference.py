@@ -16,7 +16,6 @@ from __future__ import annotations
 import argparse
 import copy
 import html
-import os
 import re
 from collections import Counter
 from dataclasses import dataclass
@@ -24,7 +23,7 @@ from dataclasses import dataclass
 from roc.cli.commands import COMMANDS, build_parser
 
 SECTION = "CLI reference"
-WIDTH = 100  # the columns argparse wraps usage lines to
+WIDTH = 100  # argparse's formatter width (it wraps nothing we print, but needs one)
 # Guide pages whose name is not commands/<group>.md (linked only when the page exists).
 GUIDES = {
     "completion": "getting-started.md#shell-completion",
@@ -38,6 +37,11 @@ _MARKDOWN_SPECIAL = re.compile(r"([\\`*_\[\]])")
 def text(value: str) -> str:
     """Help text as Markdown that shows exactly that text."""
     return _MARKDOWN_SPECIAL.sub(r"\\\1", html.escape(value, quote=False))
+
+
+def cell(value: str) -> str:
+    """Help text for a table cell (a ``|`` would end the cell)."""
+    return text(value).replace("|", "\\|")
 
 
 def code(value: str) -> str:
@@ -148,8 +152,7 @@ def _synopsis(leaf: Leaf) -> str:
 
 def group_page(group: str, leaves: list[Leaf], guide: str | None) -> str:
     """The reference page of one command group."""
-    head = leaves[0].path[:1] if leaves else (group,)
-    description = next(h for p, _a, _m, h in COMMANDS if p == head)
+    description = next(h for p, _a, _m, h in COMMANDS if p == (group,))
     lines = [f"# roc {group}", "", text(description), "",
              "Generated from roc's argument parser: the same text as `--help`."]
     if guide:
@@ -161,7 +164,7 @@ def group_page(group: str, leaves: list[Leaf], guide: str | None) -> str:
         shared = {sig: f"{slug}-{i}" for i, (sig, slug) in enumerate(shared.items(), 1)}
     if len(leaves) > 1:
         lines += ["| command | what it does |", "| --- | --- |"]
-        lines += [f"| [{code(leaf.name)}](#{leaf.anchor}) | {text(leaf.parser.description or '')} |" for leaf in leaves]
+        lines += [f"| [{code(leaf.name)}](#{leaf.anchor}) | {cell(leaf.parser.description or '')} |" for leaf in leaves]
         lines.append("")
     for leaf in leaves:
         formatter = _formatter(leaf.parser)
@@ -202,7 +205,7 @@ def index_page(parser: argparse.ArgumentParser, groups: dict[str, list[Leaf]], g
     for group in groups:
         description = next(h for p, _a, _m, h in COMMANDS if p == (group,))
         guide = f"[guide](../{guides[group]})" if group in guides else ""
-        lines.append(f"| [{code('roc ' + group)}]({group}.md) | {text(description)} | {guide} |")
+        lines.append(f"| [{code('roc ' + group)}]({group}.md) | {cell(description)} | {guide} |")
     return "\n".join(lines) + "\n"
 
 
@@ -222,6 +225,11 @@ def reference_pages(existing: set[str]) -> dict[str, str]:
     return pages
 
 
+def _nav_path(entry) -> str:
+    """The page of a nav entry: ``path`` or ``{title: path}``."""
+    return entry if isinstance(entry, str) else next(iter(entry.values()))
+
+
 # ---- MkDocs hook events -------------------------------------------------------------------------
 
 
@@ -229,14 +237,16 @@ def on_files(files, config):
     """Add the generated pages, and list them in the navigation's ``CLI reference`` section."""
     from mkdocs.structure.files import File
 
-    os.environ["COLUMNS"] = str(WIDTH)
     existing = {f.src_uri for f in files.documentation_pages()}
     pages = reference_pages(existing)
     for path, markdown in pages.items():
         files.append(File.generated(config, path, content=markdown))
+    titles = {path: "Overview" if path.endswith("/index.md") else f"roc {path[len('reference/'):-len('.md')]}"
+              for path in pages}
     for entry in config["nav"] or []:
         if isinstance(entry, dict) and SECTION in entry:
-            entry[SECTION] = [p for p in entry[SECTION] if p not in pages] + list(pages)
+            kept = [e for e in entry[SECTION] or [] if _nav_path(e) not in pages]
+            entry[SECTION] = kept + [{titles[path]: path} for path in pages]
             break
     else:
         raise ValueError(f"mkdocs.yml: the nav has no '{SECTION}' section for the generated reference")
