@@ -20,7 +20,7 @@ import re
 from collections import Counter
 from dataclasses import dataclass
 
-from roc.cli.commands import COMMANDS, build_parser
+from roc.cli import commands
 
 SECTION = "CLI reference"
 WIDTH = 100  # argparse's formatter width (it wraps nothing we print, but needs one)
@@ -67,7 +67,7 @@ def leaves_by_group(parser: argparse.ArgumentParser) -> dict[str, list[Leaf]]:
     """The parser's verbs by top-level command group, in the command table's order."""
     leaves: dict[tuple[str, ...], argparse.ArgumentParser] = parser.leaves  # type: ignore[attr-defined]
     groups: dict[str, list[Leaf]] = {}
-    for path, aliases, _module, _help in COMMANDS:
+    for path, aliases, _module, _help in commands.COMMANDS:
         groups.setdefault(path[0], [])
         if path in leaves:
             groups[path[0]].append(Leaf(path, tuple(aliases), leaves[path]))
@@ -152,7 +152,7 @@ def _synopsis(leaf: Leaf) -> str:
 
 def group_page(group: str, leaves: list[Leaf], guide: str | None) -> str:
     """The reference page of one command group."""
-    description = next(h for p, _a, _m, h in COMMANDS if p == (group,))
+    description = next(h for p, _a, _m, h in commands.COMMANDS if p == (group,))
     lines = [f"# roc {group}", "", text(description), "",
              "Generated from roc's argument parser: the same text as `--help`."]
     if guide:
@@ -203,7 +203,7 @@ def index_page(parser: argparse.ArgumentParser, groups: dict[str, list[Leaf]], g
             lines += _argument(action, formatter, "roc")
     lines += ["| command group | what it is for | guide |", "| --- | --- | --- |"]
     for group in groups:
-        description = next(h for p, _a, _m, h in COMMANDS if p == (group,))
+        description = next(h for p, _a, _m, h in commands.COMMANDS if p == (group,))
         guide = f"[guide](../{guides[group]})" if group in guides else ""
         lines.append(f"| [{code('roc ' + group)}]({group}.md) | {cell(description)} | {guide} |")
     return "\n".join(lines) + "\n"
@@ -212,7 +212,7 @@ def index_page(parser: argparse.ArgumentParser, groups: dict[str, list[Leaf]], g
 def reference_pages(existing: set[str]) -> dict[str, str]:
     """``{path under docs/: Markdown}`` of the whole reference; ``existing`` are the manual's pages,
     for the links to each group's guide."""
-    parser = build_parser()
+    parser = commands.build_parser()
     groups = leaves_by_group(parser)
     guides = {}
     for group in groups:
@@ -235,8 +235,15 @@ def _nav_path(entry) -> str:
 
 def on_files(files, config):
     """Add the generated pages, and list them in the navigation's ``CLI reference`` section."""
+    import importlib
+    import sys
+
     from mkdocs.structure.files import File
 
+    global commands
+    for name in [m for m in sys.modules if m.startswith("roc.")]:  # mkdocs serve: the parser as it is now
+        del sys.modules[name]
+    commands = importlib.import_module("roc.cli.commands")
     existing = {f.src_uri for f in files.documentation_pages()}
     pages = reference_pages(existing)
     for path, markdown in pages.items():
