@@ -40,6 +40,7 @@ def test_the_manual_builds_with_warnings_as_errors(tmp_path: Path) -> None:
 def test_a_broken_link_or_a_page_outside_the_nav_fails_the_build(tmp_path: Path) -> None:
     shutil.copytree(REPO / "docs", tmp_path / "docs")
     shutil.copy(REPO / "mkdocs.yml", tmp_path)
+    (tmp_path / "roc").symlink_to(REPO / "roc")  # mkdocs.yml watches it
     (tmp_path / "docs" / "commands" / "stray.md").write_text("# Stray\n")
     topic = tmp_path / "docs" / "commands" / "topic.md"
     topic.write_text(topic.read_text() + "\n[gone](../nowhere.md) [no anchor](../reference/topic.md#roc-topic-nope)\n")
@@ -142,7 +143,7 @@ def test_the_examples_print_what_the_page_shows(sequence: Sequence, tmp_path: Pa
     env = _environment(tmp_path / "home")
     for command in sequence.commands:
         result = subprocess.run(["bash", "-c", command.command], cwd=directory, env=env, stdin=subprocess.DEVNULL,
-                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=900)
+                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
         actual = result.stdout.splitlines()
         assert matches(command.expected, actual), (
             f"{sequence.page}:{command.line}: $ {command.command}\n--- the page shows:\n"
