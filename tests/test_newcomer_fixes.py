@@ -401,27 +401,11 @@ def test_switching_symlink_install_on_and_off_on_an_existing_build_base(tmp_path
 REPO = Path(__file__).resolve().parents[1]
 
 
-def _console_output(readme: str, command: str) -> list[str]:
-    """The lines a README console block shows after ``$ COMMAND``."""
-    lines = readme.splitlines()
-    start = lines.index(f"$ {command}") + 1
-    end = next(i for i in range(start, len(lines)) if lines[i].startswith(("$ ", "```")))
-    return [line.rstrip() for line in lines[start:end]]
-
-
-@pytest.mark.parametrize("command", ["roc work list -t", "roc work list -n --packages-up-to demo_py",
-                                     "roc work graph", "roc work info demo_py"])
-def test_readme_examples_show_the_example_workspace(command: str) -> None:
-    readme = (REPO / "README.md").read_text()
-    result = roc(*command.split()[1:], cwd=REPO / "workspaces" / "example")
-    assert result.returncode == 0, result.stderr
-    assert _console_output(readme, command) == [line.rstrip() for line in result.stdout.splitlines()]
-
-
-def test_readme_says_what_a_newcomer_needs_to_know() -> None:
-    readme = (REPO / "README.md").read_text()
-    assert "the PyPI wheels of this repository's `.venv` have no rclcpp" in readme
-    assert "`events.log` is roc's own\nJSON-lines event format" in readme
+def test_the_manual_says_what_a_newcomer_needs_to_know() -> None:
+    """(The examples of the manual and the README are run by tests/test_docs.py.)"""
+    work = " ".join((REPO / "docs" / "commands" / "work.md").read_text().split())
+    assert "the PyPI wheels of this repository's `.venv` have no rclcpp" in work
+    assert "That file is roc's own JSON-lines event format, not colcon's" in work
     bench = (REPO / "bench" / "README.md").read_text()
     assert "/work/" not in bench and "/home/" not in bench
     for script in sorted((REPO / "bench").glob("*.py")):

@@ -103,8 +103,8 @@ CONFIGURED_VERBS = ("list", "info", "graph", "build", "test", "env", "cache")
 COLCON_ONLY_OPTIONS = {
     "--mixin": "colcon-mixin; put the arguments in a [profile.NAME] of roc.toml and use --profile NAME",
     "--mixin-files": "colcon-mixin; put the arguments in a [profile.NAME] of roc.toml and use --profile NAME",
-    "--packages-select-test-failures": "colcon-test-result; roc has no test verb yet",
-    "--packages-skip-test-passed": "colcon-test-result; roc has no test verb yet",
+    "--packages-select-test-failures": "colcon-test-result; roc has it only for roc work test",
+    "--packages-skip-test-passed": "colcon-test-result; roc has it only for roc work test",
     "--log-level": "colcon's logging; use --debug for tracebacks and the log/ directory for build logs",
 }
 

@@ -13,11 +13,13 @@ from roc.render import render
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     given = parser.add_mutually_exclusive_group(required=True)
-    given.add_argument("-q", "--quaternion", nargs=4, type=float, metavar=("X", "Y", "Z", "W"))
+    given.add_argument("-q", "--quaternion", nargs=4, type=float, metavar=("X", "Y", "Z", "W"),
+                       help="a quaternion (x, y, z, w)")
     given.add_argument("-e", "--euler", nargs=3, type=float, metavar=("A", "B", "C"),
                        help="Euler angles about --axes (default sxyz: roll, pitch, yaw about the fixed x, y, z)")
     given.add_argument("-m", "--matrix", nargs=9, type=float, metavar="M", help="a rotation matrix, row by row")
-    given.add_argument("-a", "--axis-angle", nargs=4, type=float, metavar=("X", "Y", "Z", "ANGLE"))
+    given.add_argument("-a", "--axis-angle", nargs=4, type=float, metavar=("X", "Y", "Z", "ANGLE"),
+                       help="a rotation axis and an angle about it")
     given.add_argument("-t", "--transform", action="append", metavar="'X Y Z ROLL PITCH YAW' or 'X Y Z QX QY QZ QW'",
                        help="a transform; several are composed in order (parent->child, child->grandchild, ...)")
     parser.add_argument("--inverse", action="store_true", help="print the inverse of the result")

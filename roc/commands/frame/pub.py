@@ -16,8 +16,8 @@ from roc.ros.types import TF_TYPE, message_class
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("parent_frame")
-    parser.add_argument("child_frame")
+    parser.add_argument("parent_frame", help="the frame the transform is given in, e.g. map")
+    parser.add_argument("child_frame", help="the frame it places, e.g. odom")
     for axis in ("x", "y", "z"):
         parser.add_argument(f"--{axis}", type=float, default=0.0, help=f"translation along {axis} (m)")
     for angle in ("roll", "pitch", "yaw"):
