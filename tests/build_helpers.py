@@ -58,6 +58,18 @@ def sourced_values(workspace: Path, setup: str = "install/setup.bash", strict: b
     return {k: v.replace(str(workspace), "WS") for k, v in values.items()}
 
 
+def without_own_underlay(values: dict[str, str]) -> dict[str, str]:
+    """roc's sourced values less the entries of the venv's ROS 2, the underlay these tests build on:
+    roc's setup scripts chain it and colcon's cannot (it has no local_setup script, see
+    roc/environment/chain.py). PATH keeps it: the clean shell starts with the venv's bin."""
+    assert values["AMENT_PREFIX_PATH"].split(os.pathsep)[-1] == sys.prefix, values["AMENT_PREFIX_PATH"]
+    def ours(entry: str) -> bool:
+        return entry == sys.prefix or entry.startswith(sys.prefix + os.sep)
+
+    return {name: os.pathsep.join(e for e in value.split(os.pathsep) if name == "PATH" or not ours(e))
+            for name, value in values.items()}
+
+
 def installed_files(install: Path) -> set[str]:
     return {str(p.relative_to(install)) for p in install.rglob("*") if not p.is_dir()}
 

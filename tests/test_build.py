@@ -22,6 +22,7 @@ from build_helpers import (
     roc,
     ros_env,
     sourced_values,
+    without_own_underlay,
 )
 
 pytestmark = pytest.mark.slow
@@ -85,7 +86,7 @@ def test_same_tree_and_environment_as_colcon(tmp_path):
     assert result.returncode == 0, result.stdout + result.stderr
     assert comparable_install_files(ours / "install") == comparable_install_files(theirs / "install")
     assert package_dsv_files(ours / "install") == package_dsv_files(theirs / "install")
-    ours_env = sourced_values(ours)
+    ours_env = without_own_underlay(sourced_values(ours))
     theirs_env = sourced_values(theirs, strict=False)  # colcon's scripts are not `set -u` safe
     # colcon leaves an empty entry (the current directory) at the end of LD_LIBRARY_PATH; roc does not.
     theirs_env["LD_LIBRARY_PATH"] = theirs_env["LD_LIBRARY_PATH"].rstrip(":")

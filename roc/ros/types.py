@@ -14,7 +14,7 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
-from roc.environment import path_list
+from roc.environment import ament_prefixes
 from roc.errors import UsageError
 from roc.messages import did_you_mean
 
@@ -115,14 +115,10 @@ def action_class(name: str) -> type:
 
 # ---- errors -----------------------------------------------------------------------------------
 
-def _prefixes() -> list[Path]:
-    return [Path(p) for p in path_list(os.environ.get("AMENT_PREFIX_PATH"))]
-
-
 def interface_packages() -> set[str]:
-    """Interface packages in the ament index of the sourced prefixes (for did-you-mean hints)."""
+    """Interface packages in the ament index of the prefixes roc looks in (for did-you-mean hints)."""
     names: set[str] = set()
-    for prefix in _prefixes():
+    for prefix in ament_prefixes():
         index = prefix / "share" / "ament_index" / "resource_index" / "rosidl_interfaces"
         if index.is_dir():
             names.update(entry.name for entry in index.iterdir())
@@ -171,7 +167,7 @@ def _unsourced_hint(package: str, kinds: list[str], short: str) -> str:
     AMENT_PREFIX_PATH."""
     from roc.workspace.root import find_workspace_root
 
-    sourced = {p.resolve() for p in _prefixes() if p.exists()}
+    sourced = {p.resolve() for p in ament_prefixes() if p.exists()}
     root = find_workspace_root(Path.cwd())
     install = root / "install" if root else None
     if install and install.is_dir():
