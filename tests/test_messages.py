@@ -18,6 +18,7 @@ from typing import Any
 
 import pytest
 from build_helpers import REPO, in_sourced_shell, roc, ros_env
+from oracles import SHARED, require_oracle
 from rclpy.serialization import deserialize_message, serialize_message
 from rosidl_parser import definition as idl
 
@@ -36,7 +37,6 @@ from roc.ros.messages import (
 )
 from roc.ros.types import UnknownTypeError, resolve_type, type_name
 
-SHARED = Path(__file__).resolve().parents[2] / "shared"
 REFERENCE = SHARED / "reference" / "ros2cli"
 INDEX = Path(sys.prefix) / "share" / "ament_index" / "resource_index" / "rosidl_interfaces"
 
@@ -44,9 +44,7 @@ INDEX = Path(sys.prefix) / "share" / "ament_index" / "resource_index" / "rosidl_
 @pytest.fixture(scope="session")
 def oracle(tmp_path_factory: pytest.TempPathFactory) -> Any:
     """rosidl_runtime_py.convert, the code ros2 echoes messages with."""
-    archive = SHARED / "oracles" / "rosidl_runtime_py-0.13.1.tar.gz"
-    if not archive.is_file():
-        pytest.skip(f"no rosidl_runtime_py oracle at {archive}")
+    archive = require_oracle("rosidl_runtime_py", SHARED / "oracles" / "rosidl_runtime_py-0.13.1.tar.gz")
     target = tmp_path_factory.mktemp("oracle")
     with tarfile.open(archive) as tar:
         tar.extractall(target, filter="data")
@@ -177,9 +175,8 @@ def test_large_arrays_take_the_fast_path() -> None:
 
 
 def stdout_of(reference: str) -> str:
-    if not (REFERENCE / reference).is_file():
-        pytest.skip(f"no ros2 reference output at {REFERENCE / reference}")
-    text = (REFERENCE / reference).read_text()
+    require_oracle("ros2 reference outputs", REFERENCE)
+    text = require_oracle("ros2 reference output", REFERENCE / reference).read_text()
     return text.split("--- stdout ---\n", 1)[1].split("--- stderr ---\n", 1)[0]
 
 
