@@ -13,11 +13,12 @@ def warn(message: str) -> None:
     print(f"roc: warning: {message}", file=sys.stderr)
 
 
-def did_you_mean(word: str, choices: Iterable[str], count: int = 3, quote: bool = True) -> str:
-    """``did you mean 'a' or 'b'?`` for the choices closest to a misspelled ``word``, or ''."""
+def did_you_mean(word: str, choices: Iterable[str], count: int = 3, quote: bool = True, cutoff: float = 0.6) -> str:
+    """``did you mean 'a' or 'b'?`` for the choices closest to a misspelled ``word`` (a similarity of
+    at least ``cutoff``, 0 to 1), or ''."""
     import difflib
 
-    close = difflib.get_close_matches(word, sorted(choices), n=count, cutoff=0.6)
+    close = difflib.get_close_matches(word, sorted(choices), n=count, cutoff=cutoff)
     names = [f"'{name}'" if quote else name for name in close]
     return f"did you mean {' or '.join(names)}?" if names else ""
 

@@ -35,7 +35,7 @@ from roc.ros.messages import (
     parse_values,
     prototype,
 )
-from roc.ros.types import UnknownTypeError, resolve_type, type_name
+from roc.ros.types import TypeNameError, UnknownTypeError, resolve_type, type_name
 
 REFERENCE = SHARED / "reference" / "ros2cli"
 INDEX = Path(sys.prefix) / "share" / "ament_index" / "resource_index" / "rosidl_interfaces"
@@ -343,7 +343,7 @@ def test_resolve_every_spelling() -> None:
 @pytest.mark.parametrize("name, kind, message", [
     ("std_msg/msg/String", None,
      "unknown message type 'std_msg/msg/String': no interface package 'std_msg' is installed "
-     "(did you mean 'std_msgs' or 'test_msgs' or 'stereo_msgs'?); install it or source the workspace that builds it"),
+     "(did you mean 'std_msgs'?); install it or source the workspace that builds it"),
     ("std_msgs/msg/Strin", None,
      "unknown message type 'std_msgs/msg/Strin': package 'std_msgs' has no msg 'Strin' "
      "(did you mean 'String'?); see 'roc interface list'"),
@@ -363,9 +363,11 @@ def test_unknown_types(name: str, kind: str | None, message: str, monkeypatch: p
                        tmp_path: Path) -> None:
     monkeypatch.setenv("AMENT_PREFIX_PATH", sys.prefix)
     monkeypatch.chdir(tmp_path)
-    with pytest.raises(UnknownTypeError) as error:
+    with pytest.raises((UnknownTypeError, TypeNameError)) as error:
         resolve_type(name, kind)
     assert str(error.value) == message
+    # not installed: exit 1; a name no type could have, or of the wrong kind: a usage error, exit 2
+    assert error.value.exit_code == (1 if message.startswith("unknown") else 2)
 
 
 def test_unsourced_system_install_is_pointed_at(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

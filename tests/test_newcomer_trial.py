@@ -10,7 +10,18 @@ import subprocess
 import sys
 from pathlib import Path
 
-from build_helpers import REPO
+import pytest
+from build_helpers import BIN, REPO, ros_env
+from graph_helpers import graph_env
+
+from roc.cli.commands import COMMANDS, verbs
+from roc.commands.topic.pub import waiting_text
+from roc.ros.types import UnknownTypeError, resolve_type
+
+
+def cli(*args: str, env: dict[str, str], cwd: Path | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run([str(BIN / "roc"), *args], env=env, cwd=cwd, capture_output=True, text=True, timeout=60,
+                          stdin=subprocess.DEVNULL)
 
 # ---- scripts/setup.sh changes the system only when asked -----------------------------------------
 
@@ -122,3 +133,69 @@ def test_with_the_oracles_nothing_is_skipped(tmp_path: Path) -> None:
     (shared / "reference").mkdir()
     run = _run_probe_suite(tmp_path, shared, CI="true")
     assert run.returncode == 0 and "5 passed" in run.stdout, run.stdout
+
+
+# ---- exit codes and hints -------------------------------------------------------------------------
+
+TYPE_VERBS = [["topic", "pub", "/x"], ["topic", "echo", "/x"], ["interface", "show"], ["interface", "proto"]]
+
+
+@pytest.mark.parametrize("verb", TYPE_VERBS + [["service", "call", "/x"], ["action", "send_goal", "/x"]],
+                         ids=lambda verb: " ".join(verb[:2]))
+def test_every_verb_exits_1_for_a_type_not_installed_and_2_for_a_malformed_name(tmp_path: Path, verb) -> None:
+    kind = {"service": "srv", "action": "action"}.get(verb[0], "msg")
+    extra = ["{}"] if verb[0] == "action" else []
+    env = graph_env(19, tmp_path)
+    unknown = cli(*verb, f"foo_{kind}s/{kind}/Bar", *extra, env=env)
+    assert (unknown.returncode, unknown.stdout, len(unknown.stderr.splitlines())) == (1, "", 1), unknown.stderr
+    malformed = cli(*verb, "Bar", *extra, env=env)
+    assert (malformed.returncode, malformed.stdout, len(malformed.stderr.splitlines())) == (2, "", 1), malformed.stderr
+    assert not (tmp_path / "roc").exists()  # decided before any daemon was asked
+
+
+def test_only_close_interface_package_names_are_suggested() -> None:
+    with pytest.raises(UnknownTypeError) as far:
+        resolve_type("foo_msgs/msg/Bar")
+    assert "did you mean" not in str(far.value)
+    with pytest.raises(UnknownTypeError) as near:
+        resolve_type("std_msg/msg/String")
+    assert "(did you mean 'std_msgs'?)" in str(near.value)
+
+
+@pytest.mark.parametrize("words, hint", [
+    (["work", "buld"], "unknown command 'buld'; did you mean 'build'? (see 'roc work --help')"),
+    (["wrk", "build"], "unknown command 'wrk'; did you mean 'work'? (see 'roc --help')"),
+    (["work", "clean", "pakages"], "unknown command 'pakages'; did you mean 'packages'? (see 'roc work clean --help')"),
+    (["topic", "xyzzy"], "unknown command 'xyzzy'; choose from list, info, type, find, echo, pub, hz, bw, delay "
+                         "(see 'roc topic --help')"),
+])
+def test_a_mistyped_command_gets_the_closest_name(tmp_path: Path, words: list[str], hint: str) -> None:
+    result = cli(*words, env=ros_env(), cwd=tmp_path)
+    assert (result.returncode, result.stdout, result.stderr) == (2, "", f"roc: error: {hint}\n")
+
+
+def _help_of(name: str, parent_help: str) -> str:
+    """A command's help text in its parent's --help (on the next line when the name is long)."""
+    lines = parent_help.splitlines()
+    index = next(i for i, line in enumerate(lines) if line.split()[:1] == [name])
+    return " ".join((lines[index] + " " + lines[index + 1] if len(lines[index].split()) == 1 else lines[index])
+                    .split())
+
+
+def test_every_group_s_help_lists_all_its_commands(tmp_path: Path) -> None:
+    groups = [path for path, _, module, _ in COMMANDS if module is None]
+    assert ("interface",) in groups
+    wide = ros_env(COLUMNS="1000")  # no wrapped lines
+    for group in groups:
+        text = _help_of(group[-1], cli(*group[:-1], "--help", env=wide, cwd=tmp_path).stdout)
+        assert text.endswith(": " + ", ".join(verbs(group))), text
+    top = cli("--help", env=wide, cwd=tmp_path).stdout
+    assert _help_of("interface", top).endswith(": list, packages, package, show, proto")
+
+
+def test_pub_says_once_how_to_stop_waiting_instead_of_repeating_its_waiting_line() -> None:
+    lines = [waiting_text(count, 1) for count in range(1, 9)]
+    assert lines[:4] == ["Waiting for at least 1 matching subscription(s)...\n"] * 4
+    assert lines[4] == ("Still waiting for 1 matching subscription(s) after 4 s, until they appear: Ctrl+C stops, "
+                        "'-w 0' publishes without waiting, '--max-wait-time-secs SECONDS' gives up\n")
+    assert lines[5:] == ["", "", ""]

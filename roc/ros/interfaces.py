@@ -9,6 +9,7 @@ from pathlib import Path
 
 from roc.environment import ament_prefixes
 from roc.errors import RocError
+from roc.ros.types import TypeNameError
 
 KINDS = ("msg", "srv", "action")
 PRIMITIVES = {"bool", "byte", "char", "float32", "float64", "int8", "uint8", "int16", "uint16", "int32", "uint32",
@@ -55,7 +56,7 @@ def package_interfaces(package: str | None = None) -> dict[str, dict[str, list[s
 def definition_path(type_name: str) -> Path:
     parts = type_name.split("/")
     if len(parts) != 3 or not all(parts) or ".." in parts:
-        raise RocError(f"Invalid name '{type_name}'. Expected three parts separated by '/'")
+        raise TypeNameError(f"Invalid name '{type_name}'. Expected three parts separated by '/'")
     prefix = _resources("packages").get(parts[0])
     if prefix is None:
         raise RocError(f"Unknown package '{parts[0]}'")
