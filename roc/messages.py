@@ -6,6 +6,9 @@ import sys
 from collections.abc import Iterable
 
 emitted: list[str] = []
+# Package names share their suffixes (``_msgs``, ``_srvs``, ``_interfaces``), which alone makes ``foo_msgs``
+# look 60-75 % like ``tf2_msgs`` or ``std_msgs``: for them, only a name one or two typos away is suggested.
+PACKAGE_NAME_CUTOFF = 0.85
 
 
 def warn(message: str) -> None:

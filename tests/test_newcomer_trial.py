@@ -4,6 +4,8 @@ messages of clean, param set and the dependency check."""
 
 from __future__ import annotations
 
+import io
+import json
 import os
 import shutil
 import subprocess
@@ -95,9 +97,9 @@ def test_needs_nothing():
 '''
 
 
-def _run_probe_suite(tmp_path: Path, shared: Path, **extra: str) -> subprocess.CompletedProcess:
-    """pytest (two workers) on a tiny suite with tests/conftest.py and tests/oracles.py, the oracles
-    looked up in ``shared``."""
+def _run_probe_suite(tmp_path: Path, shared: Path, workers: int = 0, **extra: str) -> subprocess.CompletedProcess:
+    """pytest (on ``workers`` pytest-xdist workers, as scripts/test.sh runs it) on a tiny suite with
+    tests/conftest.py and tests/oracles.py, the oracles looked up in ``shared``."""
     suite = tmp_path / "suite"
     suite.mkdir()
     for name in ("conftest.py", "oracles.py"):
@@ -105,13 +107,14 @@ def _run_probe_suite(tmp_path: Path, shared: Path, **extra: str) -> subprocess.C
     (suite / "test_probe.py").write_text(PROBE_TESTS)
     env = {k: v for k, v in os.environ.items() if k not in ("CI", "PYTEST_ADDOPTS")}
     env.update(ROC_TEST_SHARED=str(shared), **extra)
-    return subprocess.run([sys.executable, "-m", "pytest", "-n", "2", "-p", "no:cacheprovider", "-q", str(suite)],
-                          cwd=suite, env=env, capture_output=True, text=True, timeout=120)
+    command = [sys.executable, "-m", "pytest", "-n", str(workers), "-p", "no:cacheprovider", "-q", str(suite)]
+    return subprocess.run(command, cwd=suite, env=env, capture_output=True, text=True, timeout=120)
 
 
-def test_skips_for_missing_oracles_are_summed_up_one_line_per_reason(tmp_path: Path) -> None:
+@pytest.mark.parametrize("workers", [0, pytest.param(2, marks=pytest.mark.slow)])
+def test_skips_for_missing_oracles_are_summed_up_one_line_per_reason(tmp_path: Path, workers: int) -> None:
     missing = tmp_path / "no-shared"
-    run = _run_probe_suite(tmp_path, missing)
+    run = _run_probe_suite(tmp_path, missing, workers)
     assert run.returncode == 0, run.stdout + run.stderr
     summary = run.stdout.split("missing oracles")[1].splitlines()[1:3]
     assert summary == [f"3 tests skipped: oracle ros2 CLI not found at {missing}/oracles/cli.sh",
@@ -135,6 +138,12 @@ def test_with_the_oracles_nothing_is_skipped(tmp_path: Path) -> None:
     assert run.returncode == 0 and "5 passed" in run.stdout, run.stdout
 
 
+@pytest.fixture
+def runtime(tmp_path_factory) -> Path:
+    """A runtime directory short enough for the daemon's socket (a long one falls back to a shared one)."""
+    return tmp_path_factory.mktemp("rt")
+
+
 # ---- exit codes and hints -------------------------------------------------------------------------
 
 TYPE_VERBS = [["topic", "pub", "/x"], ["topic", "echo", "/x"], ["interface", "show"], ["interface", "proto"]]
@@ -142,15 +151,16 @@ TYPE_VERBS = [["topic", "pub", "/x"], ["topic", "echo", "/x"], ["interface", "sh
 
 @pytest.mark.parametrize("verb", TYPE_VERBS + [["service", "call", "/x"], ["action", "send_goal", "/x"]],
                          ids=lambda verb: " ".join(verb[:2]))
-def test_every_verb_exits_1_for_a_type_not_installed_and_2_for_a_malformed_name(tmp_path: Path, verb) -> None:
+def test_every_verb_exits_1_for_a_type_not_installed_and_2_for_a_malformed_name(runtime: Path, verb) -> None:
     kind = {"service": "srv", "action": "action"}.get(verb[0], "msg")
     extra = ["{}"] if verb[0] == "action" else []
-    env = graph_env(19, tmp_path)
+    env = graph_env(19, runtime)
     unknown = cli(*verb, f"foo_{kind}s/{kind}/Bar", *extra, env=env)
     assert (unknown.returncode, unknown.stdout, len(unknown.stderr.splitlines())) == (1, "", 1), unknown.stderr
     malformed = cli(*verb, "Bar", *extra, env=env)
     assert (malformed.returncode, malformed.stdout, len(malformed.stderr.splitlines())) == (2, "", 1), malformed.stderr
-    assert not (tmp_path / "roc").exists()  # decided before any daemon was asked
+    status = json.loads(cli("daemon", "status", "--format", "json", env=env).stdout)
+    assert status["running"] is False  # decided before any daemon was asked
 
 
 def test_only_close_interface_package_names_are_suggested() -> None:
@@ -199,3 +209,106 @@ def test_pub_says_once_how_to_stop_waiting_instead_of_repeating_its_waiting_line
     assert lines[4] == ("Still waiting for 1 matching subscription(s) after 4 s, until they appear: Ctrl+C stops, "
                         "'-w 0' publishes without waiting, '--max-wait-time-secs SECONDS' gives up\n")
     assert lines[5:] == ["", "", ""]
+
+
+# ---- roc graph check's output -----------------------------------------------------------------------
+
+def test_the_summary_separates_names_that_have_spaces() -> None:
+    from roc.engine.events import RunFinished, TaskFailed, TaskStarted
+    from roc.handlers.console import ConsoleHandler
+
+    out = io.StringIO()
+    console = ConsoleHandler(out, kind="probe", noun="probe", cached_label="")
+    for name in ("topic /imu", "node /ghost_node", "parameter /motor_controller max_speed"):
+        console(TaskStarted(name, "probe"))
+        console(TaskFailed(name, "probe", reason="fail: no"))
+    console(RunFinished("", "probe"))
+    assert ("  3 probes failed: node /ghost_node, parameter /motor_controller max_speed, topic /imu\n"
+            in out.getvalue())
+    packages = io.StringIO()
+    console = ConsoleHandler(packages)
+    for name in ("b", "a"):
+        console(TaskFailed(name, reason="failed"))
+    console(RunFinished(""))
+    assert "  2 packages failed: a b\n" in packages.getvalue()  # as colcon
+
+
+def test_the_last_json_event_carries_the_run_s_kind() -> None:
+    from roc.engine.executor import execute
+    from roc.engine.ready import Task
+    from roc.handlers.logs import JsonEventsHandler
+
+    out = io.StringIO()
+    execute([Task(name="node /a", dependencies=set(), action=lambda context: None, kind="probe")],
+            [JsonEventsHandler(out)], 0, kind="probe")
+    last = json.loads(out.getvalue().splitlines()[-1])
+    assert (last["event"], last["kind"]) == ("RunFinished", "probe")
+
+
+def test_probe_values_are_printed_as_yaml() -> None:
+    from roc.check.probes import _mismatches
+    from roc.render import to_yaml_line
+
+    assert to_yaml_line({"success": True, "message": ""}) == "{success: true, message: ''}"
+    assert [to_yaml_line(v) for v in (1.5, "demo_bot", [1.0, 0.1], None)] == ["1.5", "demo_bot", "[1.0, 0.1]", "null"]
+    assert _mismatches({"success": True, "pose": {"x": 1}}, {"success": False, "pose": {"x": 2}}) == [
+        "success: false, expected true", "pose.x: 2, expected 1"]
+
+
+# ---- param set, clean, missing dependencies, daemon status --------------------------------------------
+
+def test_param_set_names_an_undeclared_parameter() -> None:
+    from roc.commands.param.set import named_reason
+
+    assert named_reason("max_sped", "Invalid access to undeclared parameter(s): []") == (
+        "Invalid access to undeclared parameter(s): max_sped")
+    assert named_reason("x", "Wrong parameter type") == "Wrong parameter type"
+
+
+def _package(workspace: Path, name: str, depends: tuple[str, ...] = ()) -> None:
+    directory = workspace / "src" / name
+    directory.mkdir(parents=True)
+    deps = "".join(f"<depend>{d}</depend>" for d in depends)
+    (directory / "package.xml").write_text(
+        f'<?xml version="1.0"?><package format="3"><name>{name}</name><version>0.0.1</version>'
+        f'<description>test</description><maintainer email="roc@example.com">roc</maintainer>'
+        f"<license>Apache-2.0</license>{deps}<export><build_type>cmake</build_type></export></package>")
+    (directory / "CMakeLists.txt").write_text(f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n")
+
+
+def test_clean_says_what_it_removed(tmp_path: Path) -> None:
+    workspace = tmp_path / "ws"
+    _package(workspace, "alpha")
+    for base in ("build", "install"):
+        (workspace / base / "alpha").mkdir(parents=True)
+    cleaned = cli("work", "clean", "packages", "alpha", "-y", env=ros_env(), cwd=workspace)
+    assert (cleaned.returncode, cleaned.stdout) == (0, "Removed:\n     build/alpha\n     install/alpha\n")
+    assert not (workspace / "build" / "alpha").exists()
+
+
+def test_a_dependency_found_nowhere_is_warned_about_once_with_the_closest_name(tmp_path: Path) -> None:
+    workspace = tmp_path / "ws"
+    _package(workspace, "alpha", ("std_msg", "eigen", "python3-numpy", "beta", "std_msgs"))
+    _package(workspace, "beta", ("std_msg",))
+    built = cli("work", "build", env=ros_env(), cwd=workspace)
+    assert built.returncode == 0, built.stderr
+    assert built.stderr.splitlines() == [
+        "roc: warning: 'eigen', a dependency of alpha, is in neither the workspace nor an underlay; a typo? "
+        "(a system dependency that rosdep installs is fine)",
+        "roc: warning: 'std_msg', a dependency of alpha, beta, is in neither the workspace nor an underlay; "
+        "did you mean 'std_msgs'?"]
+    only_beta = cli("work", "build", "--packages-select", "alpha", env=ros_env(), cwd=workspace)
+    assert "'std_msg', a dependency of alpha, is" in only_beta.stderr
+
+
+def test_daemon_status_says_which_daemon(runtime: Path) -> None:
+    from roc.commands.daemon.status import status_lines
+
+    running = {"running": True, "pid": 42, "socket": "/run/roc/daemon-1.sock",
+               "environment": {"ROS_DOMAIN_ID": "7", "RMW_IMPLEMENTATION": ""}}
+    assert status_lines(running) == ["The daemon is running", "  pid: 42", "  discovery environment: ROS_DOMAIN_ID=7",
+                                     "  socket: /run/roc/daemon-1.sock"]
+    env = graph_env(19, runtime)
+    stopped = json.loads(cli("daemon", "status", "--format", "json", env=env).stdout)
+    assert stopped["running"] is False and stopped["environment"]["ROS_DOMAIN_ID"] == env["ROS_DOMAIN_ID"]
+    assert stopped["socket"].startswith(f"{runtime}/roc/daemon-") and stopped["socket"].endswith(".sock")

@@ -16,7 +16,7 @@ from typing import Any
 
 from roc.environment import ament_prefixes
 from roc.errors import RocError, UsageError
-from roc.messages import did_you_mean
+from roc.messages import PACKAGE_NAME_CUTOFF, did_you_mean
 
 KINDS = ("msg", "srv", "action")
 KIND_NOUNS = {"msg": "message", "srv": "service", "action": "action"}
@@ -136,11 +136,6 @@ def _package_types(package: str, kind: str) -> list[str]:
     if module is None:
         return []
     return [n for n, v in vars(module).items() if isinstance(v, type) and "_" not in n]
-
-
-# Interface package names share their suffix (``_msgs``, ``_srvs``), which alone makes ``foo_msgs`` look
-# 60-75 % like ``tf2_msgs`` or ``std_msgs``: only a name one or two typos away is suggested.
-PACKAGE_NAME_CUTOFF = 0.85
 
 
 def _did_you_mean(word: str, choices: list[str] | set[str], cutoff: float = 0.6) -> str:
