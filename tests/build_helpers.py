@@ -29,6 +29,18 @@ def copy_fixture(name: str, destination: Path) -> Path:
     return destination
 
 
+def add_cmake_package(workspace: Path, name: str, cmakelists: str, depends: tuple[str, ...] = ()) -> None:
+    """A plain CMake package ``src/NAME`` with this CMakeLists.txt and ``<depend>``s."""
+    directory = workspace / "src" / name
+    directory.mkdir(parents=True)
+    deps = "".join(f"<depend>{d}</depend>" for d in depends)
+    (directory / "package.xml").write_text(
+        f'<?xml version="1.0"?><package format="3"><name>{name}</name><version>0.0.1</version>'
+        f'<description>test</description><maintainer email="roc@example.com">roc</maintainer>'
+        f"<license>Apache-2.0</license>{deps}<export><build_type>cmake</build_type></export></package>")
+    (directory / "CMakeLists.txt").write_text(cmakelists)
+
+
 def roc(*args: str, cwd: Path, env: dict[str, str] | None = None, timeout: float = 600) -> subprocess.CompletedProcess:
     return subprocess.run([str(BIN / "roc"), *args], cwd=cwd, env=env or ros_env(), capture_output=True,
                           text=True, timeout=timeout)

@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from build_helpers import BIN, REPO, ros_env
+from build_helpers import BIN, REPO, add_cmake_package, ros_env
 from graph_helpers import graph_env
 
 from roc.cli.commands import COMMANDS, verbs
@@ -275,14 +275,7 @@ def test_param_set_names_an_undeclared_parameter() -> None:
 
 
 def _package(workspace: Path, name: str, depends: tuple[str, ...] = ()) -> None:
-    directory = workspace / "src" / name
-    directory.mkdir(parents=True)
-    deps = "".join(f"<depend>{d}</depend>" for d in depends)
-    (directory / "package.xml").write_text(
-        f'<?xml version="1.0"?><package format="3"><name>{name}</name><version>0.0.1</version>'
-        f'<description>test</description><maintainer email="roc@example.com">roc</maintainer>'
-        f"<license>Apache-2.0</license>{deps}<export><build_type>cmake</build_type></export></package>")
-    (directory / "CMakeLists.txt").write_text(f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n")
+    add_cmake_package(workspace, name, f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n", depends)
 
 
 def test_clean_says_what_it_removed(tmp_path: Path) -> None:
