@@ -6,6 +6,9 @@ import sys
 from collections.abc import Iterable
 
 emitted: list[str] = []
+# Package names share their suffixes (``_msgs``, ``_srvs``, ``_interfaces``), which alone makes ``foo_msgs``
+# look 60-75 % like ``tf2_msgs`` or ``std_msgs``: for them, only a name one or two typos away is suggested.
+PACKAGE_NAME_CUTOFF = 0.85
 
 
 def warn(message: str) -> None:
@@ -13,11 +16,12 @@ def warn(message: str) -> None:
     print(f"roc: warning: {message}", file=sys.stderr)
 
 
-def did_you_mean(word: str, choices: Iterable[str], count: int = 3, quote: bool = True) -> str:
-    """``did you mean 'a' or 'b'?`` for the choices closest to a misspelled ``word``, or ''."""
+def did_you_mean(word: str, choices: Iterable[str], count: int = 3, quote: bool = True, cutoff: float = 0.6) -> str:
+    """``did you mean 'a' or 'b'?`` for the choices closest to a misspelled ``word`` (a similarity of
+    at least ``cutoff``, 0 to 1), or ''."""
     import difflib
 
-    close = difflib.get_close_matches(word, sorted(choices), n=count, cutoff=0.6)
+    close = difflib.get_close_matches(word, sorted(choices), n=count, cutoff=cutoff)
     names = [f"'{name}'" if quote else name for name in close]
     return f"did you mean {' or '.join(names)}?" if names else ""
 

@@ -54,6 +54,15 @@ def to_yaml(data: Any, flow_style: bool | None = False) -> str:
     return yaml.dump(data, sort_keys=False, default_flow_style=flow_style, allow_unicode=True)
 
 
+def to_yaml_line(data: Any) -> str:
+    """Data as one line of YAML in flow style (``{success: true, message: ''}``, ``1.5``, ``[1, 2]``), for
+    a value inside a line of text."""
+    import yaml
+
+    text = yaml.dump(data, sort_keys=False, default_flow_style=True, allow_unicode=True, width=2**31 - 1)
+    return text.removesuffix("\n").removesuffix("\n...").strip()
+
+
 @lru_cache(maxsize=2)
 def _message_dumper(fast: bool) -> type:
     """A yaml Dumper (libyaml's when ``fast``) whose mappings never take the flow style, as

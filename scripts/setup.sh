@@ -7,8 +7,13 @@
 # Idempotent: when nothing it depends on changed since the last successful run (stamp in
 # .venv/.roc-setup-stamp) it only re-checks the fix-ups and prints one line.
 # Only the dev/CI environment lives here: roc itself never assumes the venv's paths.
+# It changes nothing outside the checkout (and pip's cache) unless asked:
+#   ROC_SETUP_SHELLS=1  also install zsh and fish with the system's package manager (apt-get, as root),
+#                       so that the tests of roc's zsh/fish setup scripts and completions run instead of
+#                       skipping; CI sets it (.ci/run). Without it, missing shells are only reported.
 # Environment: PYTHON (interpreter that creates the venv, default python3),
-#              ROC_SETUP_FORCE=1 (redo the pip steps even if the stamp matches).
+#              ROC_SETUP_FORCE=1 (redo the pip steps even if the stamp matches),
+#              ROC_SETUP_SHELLS=1 (see above).
 set -euo pipefail
 
 ROOT="$(cd -- "$(dirname -- "${BASH_SOURCE[0]}")/.." && pwd -P)"
@@ -53,27 +58,39 @@ sys.exit(0 if os.path.realpath(roc.__file__).startswith(os.path.realpath(sys.arg
 EOF
 }
 
+# ---- shells the tests source roc's setup scripts in (opt-in: their tests skip without them) ----
+# Installed only with ROC_SETUP_SHELLS=1; otherwise a full set-up says which are missing.
+setup_shells() {
+    local missing=() shell
+    for shell in zsh fish; do
+        command -v "$shell" >/dev/null 2>&1 || missing+=("$shell")
+    done
+    [ "${#missing[@]}" -gt 0 ] || return 0
+    if [ "${ROC_SETUP_SHELLS:-0}" != 1 ]; then
+        [ "$1" = quiet ] || say "${missing[*]} not installed: their tests will be skipped (ROC_SETUP_SHELLS=1 installs them)"
+    elif [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+        say "ROC_SETUP_SHELLS=1: installing ${missing[*]} with apt-get"
+        { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}"; } \
+            >/dev/null 2>&1 || say "could not install ${missing[*]}; their tests will be skipped"
+    else
+        say "ROC_SETUP_SHELLS=1: install ${missing[*]} yourself (this needs root and apt-get)"
+    fi
+}
+
 # ---- quick path -------------------------------------------------------------------------
 if [ "${ROC_SETUP_FORCE:-0}" != 1 ] && [ -f "$STAMP" ] && venv_ok \
         && [ "$(cat -- "$STAMP")" = "$(want_stamp)" ]; then
     # Cheap safety net in case a wheel was reinstalled by hand: silent when nothing changes.
     "$VPY" "$ROOT/scripts/fix_ros_wheels.py" --quiet
     "$VPY" -m compileall -q "$ROOT/roc" >/dev/null  # only what changed since the last run
+    setup_shells quiet
     say "environment up to date ($VENV); set ROC_SETUP_FORCE=1 to redo it"
     exit 0
 fi
 
 start=$SECONDS
 export PIP_NO_INPUT=1 PIP_DISABLE_PIP_VERSION_CHECK=1
-
-# ---- shells the tests source roc's setup scripts in (optional: their tests skip without them) --
-if ! command -v zsh >/dev/null 2>&1 || ! command -v fish >/dev/null 2>&1; then
-    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-        say "installing zsh and fish (apt-get)"
-        { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq zsh fish; } >/dev/null 2>&1 \
-            || say "could not install zsh/fish; their tests will be skipped"
-    fi
-fi
+setup_shells loud
 
 # ---- venv -------------------------------------------------------------------------------
 if [ ! -x "$VPY" ] || ! "$VPY" -c '' >/dev/null 2>&1; then
@@ -95,14 +112,18 @@ pip_q install -q --upgrade pip
 say "installing roc (editable, with the test extra) and the ROS 2 Jazzy wheels"
 # 'compat' puts the checkout on sys.path with a plain .pth entry; the default editable mode adds an
 # import hook that costs ~10 ms at every roc start. Should setuptools drop 'compat', use the default.
-pip_q install -q --config-settings editable_mode=compat -e "$ROOT[test]" -r "$ROOT/requirements/ros-jazzy.txt" \
+# (setuptools' notice that 'compat' is transitional is left out: it is the comment above)
+PYTHONWARNINGS="ignore:Compat editable installs" \
+    pip_q install -q --config-settings editable_mode=compat -e "$ROOT[test]" -r "$ROOT/requirements/ros-jazzy.txt" \
     || pip_q install -q -e "$ROOT[test]" -r "$ROOT/requirements/ros-jazzy.txt"
 
 # ---- the colcon oracle's setuptools -------------------------------------------------------
 # colcon reads a setup.py through the setuptools it runs with, and setuptools 72+ (which grpcio-tools
 # needs) drops tests_require. The tests run colcon's package identification with Jazzy's platform
 # setuptools (Ubuntu 24.04: 68.1.2), kept apart from the venv's (tests/fixture_workspaces.py).
-pip_q install -q --upgrade --target "$VENV/oracle-setuptools" "setuptools==68.1.2"
+# pip checks the dependencies of what it installs against the venv's packages even with --target, and
+# would report grpcio-tools' need of setuptools>=77 as an ERROR although the venv's setuptools is untouched.
+pip_q install -q --no-warn-conflicts --upgrade --target "$VENV/oracle-setuptools" "setuptools==68.1.2"
 
 # ---- fix-ups of the wheels' CMake files ---------------------------------------------------
 "$VPY" "$ROOT/scripts/fix_ros_wheels.py"

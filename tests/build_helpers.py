@@ -29,6 +29,18 @@ def copy_fixture(name: str, destination: Path) -> Path:
     return destination
 
 
+def add_cmake_package(workspace: Path, name: str, cmakelists: str, depends: tuple[str, ...] = ()) -> None:
+    """A plain CMake package ``src/NAME`` with this CMakeLists.txt and ``<depend>``s."""
+    directory = workspace / "src" / name
+    directory.mkdir(parents=True)
+    deps = "".join(f"<depend>{d}</depend>" for d in depends)
+    (directory / "package.xml").write_text(
+        f'<?xml version="1.0"?><package format="3"><name>{name}</name><version>0.0.1</version>'
+        f'<description>test</description><maintainer email="roc@example.com">roc</maintainer>'
+        f"<license>Apache-2.0</license>{deps}<export><build_type>cmake</build_type></export></package>")
+    (directory / "CMakeLists.txt").write_text(cmakelists)
+
+
 def roc(*args: str, cwd: Path, env: dict[str, str] | None = None, timeout: float = 600) -> subprocess.CompletedProcess:
     return subprocess.run([str(BIN / "roc"), *args], cwd=cwd, env=env or ros_env(), capture_output=True,
                           text=True, timeout=timeout)
@@ -56,6 +68,18 @@ def sourced_values(workspace: Path, setup: str = "install/setup.bash", strict: b
     assert result.returncode == 0, result.stderr
     values = dict(line.split("=", 1) for line in result.stdout.splitlines())
     return {k: v.replace(str(workspace), "WS") for k, v in values.items()}
+
+
+def without_own_underlay(values: dict[str, str]) -> dict[str, str]:
+    """roc's sourced values less the entries of the venv's ROS 2, the underlay these tests build on:
+    roc's setup scripts chain it and colcon's cannot (it has no local_setup script, see
+    roc/environment/chain.py). PATH keeps it: the clean shell starts with the venv's bin."""
+    assert values["AMENT_PREFIX_PATH"].split(os.pathsep)[-1] == sys.prefix, values["AMENT_PREFIX_PATH"]
+    def ours(entry: str) -> bool:
+        return entry == sys.prefix or entry.startswith(sys.prefix + os.sep)
+
+    return {name: os.pathsep.join(e for e in value.split(os.pathsep) if name == "PATH" or not ours(e))
+            for name, value in values.items()}
 
 
 def installed_files(install: Path) -> set[str]:

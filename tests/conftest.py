@@ -1,8 +1,30 @@
-"""The suite's processes stop on SIGINT (the tests' Ctrl+C) even when the suite was started with
-SIGINT ignored, as a shell does for a command it runs in the background (``bash scripts/test.sh &``):
-an ignored signal stays ignored in every child, a handled one is reset to its default."""
+"""Suite-wide set-up.
+
+- The suite's processes stop on SIGINT (the tests' Ctrl+C) even when the suite was started with SIGINT
+  ignored, as a shell does for a command it runs in the background (``bash scripts/test.sh &``): an
+  ignored signal stays ignored in every child, a handled one is reset to its default.
+- Tests skipped because an oracle is missing (tests/oracles.py) are summed up at the end of the run,
+  one line per reason, so that a checkout without ``../shared`` says what it did not test.
+"""
 
 import signal
+from collections import Counter
 
 if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
+def _skip_reason(report) -> str:
+    longrepr = report.longrepr
+    reason = longrepr[2] if isinstance(longrepr, tuple) and len(longrepr) == 3 else str(longrepr)
+    return reason.removeprefix("Skipped: ")
+
+
+def pytest_terminal_summary(terminalreporter) -> None:
+    reasons = Counter(_skip_reason(r) for r in terminalreporter.stats.get("skipped", []))
+    missing = sorted(((reason, count) for reason, count in reasons.items() if reason.startswith("oracle ")),
+                     key=lambda item: (-item[1], item[0]))  # the most skipped first
+    if missing:
+        terminalreporter.section("missing oracles")
+        for reason, count in missing:
+            terminalreporter.write_line(f"{count} test{'s' if count != 1 else ''} skipped: {reason}")

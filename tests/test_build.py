@@ -14,6 +14,7 @@ import psutil
 import pytest
 from build_helpers import (
     BIN,
+    add_cmake_package,
     colcon,
     comparable_install_files,
     copy_fixture,
@@ -22,20 +23,10 @@ from build_helpers import (
     roc,
     ros_env,
     sourced_values,
+    without_own_underlay,
 )
 
 pytestmark = pytest.mark.slow
-
-
-def _add_package(workspace: Path, name: str, cmakelists: str, depends: tuple[str, ...] = ()) -> None:
-    directory = workspace / "src" / name
-    directory.mkdir(parents=True)
-    deps = "".join(f"<depend>{d}</depend>" for d in depends)
-    (directory / "package.xml").write_text(
-        f'<?xml version="1.0"?><package format="3"><name>{name}</name><version>0.0.1</version>'
-        f'<description>test</description><maintainer email="roc@example.com">roc</maintainer>'
-        f"<license>Apache-2.0</license>{deps}<export><build_type>cmake</build_type></export></package>")
-    (directory / "CMakeLists.txt").write_text(cmakelists)
 
 
 def test_build_then_source_and_run(tmp_path):
@@ -85,7 +76,7 @@ def test_same_tree_and_environment_as_colcon(tmp_path):
     assert result.returncode == 0, result.stdout + result.stderr
     assert comparable_install_files(ours / "install") == comparable_install_files(theirs / "install")
     assert package_dsv_files(ours / "install") == package_dsv_files(theirs / "install")
-    ours_env = sourced_values(ours)
+    ours_env = without_own_underlay(sourced_values(ours))
     theirs_env = sourced_values(theirs, strict=False)  # colcon's scripts are not `set -u` safe
     # colcon leaves an empty entry (the current directory) at the end of LD_LIBRARY_PATH; roc does not.
     theirs_env["LD_LIBRARY_PATH"] = theirs_env["LD_LIBRARY_PATH"].rstrip(":")
@@ -115,8 +106,10 @@ def test_symlink_install_shows_python_edits_without_rebuild(tmp_path):
 
 def _broken_workspace(tmp_path: Path) -> Path:
     ws = copy_fixture("build_small", tmp_path / "ws")
-    _add_package(ws, "broken", "cmake_minimum_required(VERSION 3.8)\nproject(broken C)\nmessage(FATAL_ERROR \"on purpose\")\n")
-    _add_package(ws, "needs_broken", "cmake_minimum_required(VERSION 3.8)\nproject(needs_broken NONE)\n", ("broken",))
+    add_cmake_package(ws, "broken",
+                      "cmake_minimum_required(VERSION 3.8)\nproject(broken C)\nmessage(FATAL_ERROR \"on purpose\")\n")
+    add_cmake_package(ws, "needs_broken", "cmake_minimum_required(VERSION 3.8)\nproject(needs_broken NONE)\n",
+                      ("broken",))
     return ws
 
 
@@ -143,7 +136,7 @@ def test_continue_on_error_skips_only_dependents(tmp_path):
 
 def test_ctrl_c_stops_every_process(tmp_path):
     ws = copy_fixture("build_small", tmp_path / "ws")
-    _add_package(ws, "sleeper", "cmake_minimum_required(VERSION 3.8)\nproject(sleeper NONE)\n"
+    add_cmake_package(ws, "sleeper", "cmake_minimum_required(VERSION 3.8)\nproject(sleeper NONE)\n"
                                 "add_custom_target(wait ALL COMMAND sleep 120)\n")
     process = subprocess.Popen([str(BIN / "roc"), "work", "build", "--packages-select", "sleeper"], cwd=ws,
                                env=ros_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)

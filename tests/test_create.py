@@ -25,6 +25,7 @@ from build_helpers import (
     ros_env,
     sourced_values,
     stop_process,
+    without_own_underlay,
 )
 from catkin_pkg.package import parse_package
 
@@ -232,7 +233,7 @@ def test_generated_packages_build_the_same_with_colcon(tmp_path):
     ours, theirs = (trees[tool] / "install" for tool in ("roc", "colcon"))
     assert comparable_install_files(ours) == comparable_install_files(theirs)
     assert package_dsv_files(ours) == package_dsv_files(theirs)
-    ours_env = sourced_values(trees["roc"])
+    ours_env = without_own_underlay(sourced_values(trees["roc"]))
     theirs_env = sourced_values(trees["colcon"], strict=False)
     theirs_env["LD_LIBRARY_PATH"] = theirs_env["LD_LIBRARY_PATH"].rstrip(":")  # colcon's empty entry
     assert ours_env == theirs_env

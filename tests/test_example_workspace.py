@@ -18,6 +18,7 @@ from build_helpers import (
     ros_domain_id,
     sourced_values,
     stop_process,
+    without_own_underlay,
 )
 from powershell_parse import check_package_scripts, parse
 
@@ -97,7 +98,7 @@ def test_same_install_tree_and_environment_as_colcon(example, tmp_path):
     assert result.returncode == 0, result.stdout + result.stderr
     assert comparable_install_files(example / "install") == comparable_install_files(theirs / "install")
     assert package_dsv_files(example / "install") == package_dsv_files(theirs / "install")
-    ours_env = sourced_values(example)
+    ours_env = without_own_underlay(sourced_values(example))
     theirs_env = sourced_values(theirs, strict=False)
     theirs_env["LD_LIBRARY_PATH"] = theirs_env["LD_LIBRARY_PATH"].rstrip(":")  # colcon's empty entry
     assert {k: v.replace(str(example), "WS") for k, v in ours_env.items()} == \

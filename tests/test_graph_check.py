@@ -64,7 +64,7 @@ VIOLATIONS = {
         "fail: QoS incompatible (reliability): talker -> listener: publisher offers BEST_EFFORT, subscriber requests RELIABLE",
     '[[check.parameter]]\nnode = "/motor"\nname = "max_speed"\nvalue = 2.0': "fail: 1.5, expected 2.0",
     '[[check.service]]\nname = "/motor/enable"\nrequest = "{data: true}"\nresponse = { success = true }':
-        "fail: response success: False, expected True",
+        "fail: response success: false, expected true",
     '[[check.service]]\nname = "/nobody/home"': "fail: no service /nobody/home",
 }
 

@@ -81,7 +81,7 @@ def test_echo_errors_are_one_line(graph) -> None:
     assert quiet.returncode == 1
     assert quiet.stderr == "roc: error: no message on /nobody within 1 s (--timeout)\n"
     unknown = roc("topic", "echo", "/chatter", "nope_msgs/msg/Nope", env=env)
-    assert unknown.returncode == 2 and "unknown message type 'nope_msgs/msg/Nope'" in unknown.stderr
+    assert unknown.returncode == 1 and "unknown message type 'nope_msgs/msg/Nope'" in unknown.stderr
 
 
 def _received(listener: subprocess.Popen, count: int, timeout: float = 10.0) -> list[str]:

@@ -18,6 +18,7 @@ from typing import Any
 
 import pytest
 from build_helpers import REPO, in_sourced_shell, roc, ros_env
+from oracles import SHARED, require_oracle
 from rclpy.serialization import deserialize_message, serialize_message
 from rosidl_parser import definition as idl
 
@@ -34,9 +35,8 @@ from roc.ros.messages import (
     parse_values,
     prototype,
 )
-from roc.ros.types import UnknownTypeError, resolve_type, type_name
+from roc.ros.types import TypeNameError, UnknownTypeError, resolve_type, type_name
 
-SHARED = Path(__file__).resolve().parents[2] / "shared"
 REFERENCE = SHARED / "reference" / "ros2cli"
 INDEX = Path(sys.prefix) / "share" / "ament_index" / "resource_index" / "rosidl_interfaces"
 
@@ -44,9 +44,7 @@ INDEX = Path(sys.prefix) / "share" / "ament_index" / "resource_index" / "rosidl_
 @pytest.fixture(scope="session")
 def oracle(tmp_path_factory: pytest.TempPathFactory) -> Any:
     """rosidl_runtime_py.convert, the code ros2 echoes messages with."""
-    archive = SHARED / "oracles" / "rosidl_runtime_py-0.13.1.tar.gz"
-    if not archive.is_file():
-        pytest.skip(f"no rosidl_runtime_py oracle at {archive}")
+    archive = require_oracle("rosidl_runtime_py", SHARED / "oracles" / "rosidl_runtime_py-0.13.1.tar.gz")
     target = tmp_path_factory.mktemp("oracle")
     with tarfile.open(archive) as tar:
         tar.extractall(target, filter="data")
@@ -177,9 +175,8 @@ def test_large_arrays_take_the_fast_path() -> None:
 
 
 def stdout_of(reference: str) -> str:
-    if not (REFERENCE / reference).is_file():
-        pytest.skip(f"no ros2 reference output at {REFERENCE / reference}")
-    text = (REFERENCE / reference).read_text()
+    require_oracle("ros2 reference outputs", REFERENCE)
+    text = require_oracle("ros2 reference output", REFERENCE / reference).read_text()
     return text.split("--- stdout ---\n", 1)[1].split("--- stderr ---\n", 1)[0]
 
 
@@ -346,7 +343,7 @@ def test_resolve_every_spelling() -> None:
 @pytest.mark.parametrize("name, kind, message", [
     ("std_msg/msg/String", None,
      "unknown message type 'std_msg/msg/String': no interface package 'std_msg' is installed "
-     "(did you mean 'std_msgs' or 'test_msgs' or 'stereo_msgs'?); install it or source the workspace that builds it"),
+     "(did you mean 'std_msgs'?); install it or source the workspace that builds it"),
     ("std_msgs/msg/Strin", None,
      "unknown message type 'std_msgs/msg/Strin': package 'std_msgs' has no msg 'Strin' "
      "(did you mean 'String'?); see 'roc interface list'"),
@@ -366,9 +363,11 @@ def test_unknown_types(name: str, kind: str | None, message: str, monkeypatch: p
                        tmp_path: Path) -> None:
     monkeypatch.setenv("AMENT_PREFIX_PATH", sys.prefix)
     monkeypatch.chdir(tmp_path)
-    with pytest.raises(UnknownTypeError) as error:
+    with pytest.raises((UnknownTypeError, TypeNameError)) as error:
         resolve_type(name, kind)
     assert str(error.value) == message
+    # not installed: exit 1; a name no type could have, or of the wrong kind: a usage error, exit 2
+    assert error.value.exit_code == (1 if message.startswith("unknown") else 2)
 
 
 def test_unsourced_system_install_is_pointed_at(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

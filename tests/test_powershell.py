@@ -14,6 +14,7 @@ import pytest
 from build_helpers import BIN, copy_fixture, in_sourced_shell, roc
 from powershell_parse import PARSER, applied, check_package_scripts, parse, statements
 
+from roc.environment.chain import Underlay
 from roc.environment.dsv import Operation
 from roc.shell.scripts import render
 
@@ -27,8 +28,11 @@ def test_the_parser_finds_errors():
 def test_quoting_keeps_any_path():
     """Single quotes, PowerShell's typographic quotes, $, backticks and spaces in a path survive."""
     odd = "/w s/it's ‘x’ $HOME `n \"q\""
-    text = render("setup.ps1.j2", underlays=[odd])
+    text = render("setup.ps1.j2", underlays=[Underlay(odd)])
     assert ("=", "$_roc_setup_script", f"{odd}/local_setup.ps1") in statements(text)
+    baked = render("setup.ps1.j2", underlays=[Underlay(odd, (Operation("prepend-non-duplicate", "PATH", ("bin",)),))])
+    assert ("=", "$_roc_package_prefix", odd) in statements(baked)
+    assert ("_roc_prepend_unique", "PATH", "PREFIX/bin") in applied(baked)
 
 
 def test_every_dsv_operation_kind():

@@ -148,7 +148,7 @@ def test_help(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["nosuchcommand"], "roc: error: argument COMMAND: invalid choice: 'nosuchcommand'"),
+    (["nosuchcommand"], "roc: error: unknown command 'nosuchcommand'; choose from work, w, topic"),
     (["work", "list", "--bogus"], "roc: error: unrecognized arguments: --bogus"),
     (["work", "list", "-n", "-p"], "not allowed with argument"),
     (["work", "graph", "--format", "yaml"], "invalid choice: 'yaml'"),

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import json
 import os
-import sys
 from pathlib import Path
 
 from roc.builder.layout import package_prefix
 from roc.buildtypes.context import BuildOptions
-from roc.environment import path_list
+from roc.environment import path_list, with_implicit_underlay
 from roc.environment.dsv import apply_operations, resolve_operations
 from roc.workspace.package import Package
 
@@ -17,13 +16,8 @@ ENVIRONMENT_FILE = "roc_build_environment.json"
 
 
 def base_environment() -> dict[str, str]:
-    """The calling environment. When no ROS environment is sourced but roc's own Python prefix holds
-    ROS packages (ROS installed from wheels into a venv), that prefix is the underlay."""
-    env = dict(os.environ)
-    prefix = Path(sys.prefix)
-    if not env.get("AMENT_PREFIX_PATH") and (prefix / "share" / "ament_index" / "resource_index").is_dir():
-        env["AMENT_PREFIX_PATH"] = str(prefix)
-    return env
+    """The calling environment, on roc's implicit underlay when no ROS environment is sourced."""
+    return with_implicit_underlay(os.environ)
 
 
 def build_environment(package: Package, dependencies: list[str], options: BuildOptions) -> dict[str, str]:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from roc.environment import path_list
 from roc.errors import RocError, UsageError
 from roc.fsutil import write_text_atomic
 from roc.workspace.dependencies import layered_order
@@ -66,10 +65,12 @@ def installed_in_order(install_base: Path, merged: bool) -> list[str]:
 
 def refresh_install_scripts(install_base: Path, merged: bool) -> None:
     """The install-level setup scripts for every package now in the base, chained to the underlays
-    of the current environment (COLCON_PREFIX_PATH)."""
+    the build used (roc.environment.chain)."""
     import os
 
+    from roc.environment import with_implicit_underlay
+    from roc.environment.chain import chained_underlays
     from roc.shell.scripts import write_install_scripts
 
-    underlays = path_list(os.environ.get("COLCON_PREFIX_PATH"))
+    underlays = chained_underlays(with_implicit_underlay(os.environ), install_base)
     write_install_scripts(install_base, installed_in_order(install_base, merged), merged, underlays)

@@ -12,6 +12,7 @@ from typing import Any
 
 from roc.check.expectations import Expectation
 from roc.errors import RocError
+from roc.render import to_yaml_line
 from roc.ros.present import is_hidden, qos_problems
 from roc.ros.rates import Window, samples
 
@@ -55,43 +56,56 @@ def _node(expectation: Expectation, session, _timeout: float, _window: float) ->
 
 
 def _topic(expectation: Expectation, session, timeout: float, window: float) -> tuple[str, Any]:
+    """Every expectation of the topic is checked, and every one it misses is reported (a QoS problem
+    does not hide a rate below ``min-rate``)."""
     expected = expectation.values
     try:
         info = session.query("topic_endpoints", {"topic": expectation.name})
     except RocError:
         raise Failed(f"no topic {expectation.name}") from None
     found: list[str] = [f"type {', '.join(info['types'])}"]
+    failures: list[str] = []
     measured: dict[str, Any] = {"types": info["types"], "publishers": len(info["publishers"]),
                                 "subscribers": len(info["subscribers"])}
     if "type" in expected and expected["type"] not in info["types"]:
-        raise Failed(f"type {', '.join(info['types'])}, expected {expected['type']}", measured)
+        failures.append(f"type {', '.join(info['types'])}, expected {expected['type']}")
     for side in ("publishers", "subscribers"):
         if side in expected and measured[side] != expected[side]:
-            raise Failed(f"{measured[side]} {side}, expected {expected[side]}", measured)
+            failures.append(f"{measured[side]} {side}, expected {expected[side]}")
     for policy in ("reliability", "durability"):
         if policy in expected:
             offered = sorted({p["qos"][policy].lower() for p in info["publishers"]})
             if offered != [expected[policy]]:
-                raise Failed(f"publishers offer {policy} {', '.join(offered) or 'nothing'}, expected "
-                             f"{expected[policy]}", measured)
+                failures.append(f"publishers offer {policy} {', '.join(offered) or 'nothing'}, expected "
+                                f"{expected[policy]}")
     if expected.get("compatible", True):
-        for publisher in info["publishers"]:
-            for subscriber in info["subscribers"]:
-                problems = qos_problems(publisher, subscriber)
-                if problems:
-                    raise Failed(f"QoS incompatible ({problems[0]['policy']}): {publisher['node_name']} -> "
-                                 f"{subscriber['node_name']}: {problems[0]['message']}", measured)
+        failures += _qos_incompatibilities(info)
     if "min-rate" in expected or "max-rate" in expected:
         rate = measure_rates(session, [expectation.name], min(window, timeout)).get(expectation.name)
         measured["rate"] = rate
+        bounds = " to ".join(f"{expected[k]:g}" for k in ("min-rate", "max-rate") if k in expected)
         if rate is None:
-            raise Failed(f"no messages in {window:g} s, expected at least {expected.get('min-rate', 0):g} Hz", measured)
-        if rate < expected.get("min-rate", 0.0) or rate > expected.get("max-rate", float("inf")):
-            bounds = " to ".join(f"{expected[k]:g}" for k in ("min-rate", "max-rate") if k in expected)
-            raise Failed(f"{rate:.2f} Hz, expected {bounds} Hz", measured)
-        found.append(f"{rate:.2f} Hz")
+            failures.append(f"no messages in {window:g} s, expected {bounds} Hz")
+        elif rate < expected.get("min-rate", 0.0) or rate > expected.get("max-rate", float("inf")):
+            failures.append(f"{rate:.2f} Hz, expected {bounds} Hz")
+        else:
+            found.append(f"{rate:.2f} Hz")
+    if failures:
+        raise Failed("; ".join(failures), measured)
     found.append(f"{measured['publishers']} publishers, {measured['subscribers']} subscribers")
     return ", ".join(found), measured
+
+
+def _qos_incompatibilities(info: dict[str, Any]) -> list[str]:
+    """The first QoS problem of each publisher-subscriber pair that cannot match."""
+    found = []
+    for publisher in info["publishers"]:
+        for subscriber in info["subscribers"]:
+            problems = qos_problems(publisher, subscriber)
+            if problems:
+                found.append(f"QoS incompatible ({problems[0]['policy']}): {publisher['node_name']} -> "
+                             f"{subscriber['node_name']}: {problems[0]['message']}")
+    return found
 
 
 def measure_rates(session, topics: list[str], seconds: float) -> dict[str, float]:
@@ -135,7 +149,7 @@ def _service(expectation: Expectation, session, timeout: float, _window: float) 
             mismatched = _mismatches(expected.get("response", {}), response)
             if mismatched:
                 raise Failed(f"response {mismatched[0]}", response)
-            return f"answered {response}", response
+            return f"answered {to_yaml_line(response)}", response
         if time.monotonic() >= deadline:
             raise Failed(f"no response within {timeout:g} s")
     raise RocError("the call ended without a response")
@@ -152,7 +166,7 @@ def _mismatches(expected: dict[str, Any], actual: dict[str, Any], path: str = ""
         elif isinstance(want, dict) and isinstance(actual[key], dict):
             found += _mismatches(want, actual[key], f"{where}.")
         elif actual[key] != want:
-            found.append(f"{where}: {actual[key]!r}, expected {want!r}")
+            found.append(f"{where}: {to_yaml_line(actual[key])}, expected {to_yaml_line(want)}")
     return found
 
 
@@ -173,10 +187,10 @@ def _parameter(expectation: Expectation, session, _timeout: float, _window: floa
     except RocError as error:
         raise Failed(f"{node}: {error}") from None
     if value["type"] == "not set":
-        raise Failed(f"not set, expected {want!r}")
+        raise Failed(f"not set, expected {to_yaml_line(want)}")
     if value["value"] != want:
-        raise Failed(f"{value['value']!r}, expected {want!r}", value["value"])
-    return f"{value['value']!r}", value["value"]
+        raise Failed(f"{to_yaml_line(value['value'])}, expected {to_yaml_line(want)}", value["value"])
+    return to_yaml_line(value["value"]), value["value"]
 
 
 PROBES: dict[str, Callable[[Expectation, Any, float, float], tuple[str, Any]]] = {

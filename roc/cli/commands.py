@@ -14,23 +14,24 @@ from roc import __version__
 from roc.errors import EXIT_USAGE
 from roc.messages import did_you_mean
 
-# (command path, aliases, module in roc.commands, help)
+# (command path, aliases, module in roc.commands, help); a group's help (module None) is followed by the
+# names of its commands in the parser
 COMMANDS = (
-    (("work",), ("w",), None, "workspace: list, inspect and build packages"),
+    (("work",), ("w",), None, "the workspace's packages"),
     (("work", "list"), ("ls",), "work.list", "list the packages of the workspace (like colcon list)"),
     (("work", "info"), (), "work.info", "show package details (like colcon info)"),
     (("work", "graph"), (), "work.graph", "show the dependency graph (like colcon graph)"),
     (("work", "build"), ("b",), "work.build", "build the workspace (a drop-in for colcon build)"),
     (("work", "test"), ("t",), "work.test", "test the workspace's packages (a drop-in for colcon test)"),
     (("work", "test-result"), (), "work.test_result", "summarize the test results (like colcon test-result)"),
-    (("work", "clean"), (), None, "remove build, install, log and test result directories (like colcon clean)"),
+    (("work", "clean"), (), None, "remove build, install, log and test result directories, like colcon clean"),
     (("work", "clean", "workspace"), (), "work.clean.workspace", "clean the whole workspace's bases"),
     (("work", "clean", "packages"), (), "work.clean.packages", "clean the selected packages' directories"),
     (("work", "env"), (), "work.env", "print a package's build environment, or run a command in it"),
     (("work", "cache"), (), "work.cache", "CI caching of build results: cache key | export PATH | import PATH"),
     (("work", "config"), (), "work.config", "print the effective configuration and where each value comes from"),
     (("work", "create"), (), "work.create", "create a new package from a template (like ros2 pkg create)"),
-    (("topic",), (), None, "ROS topics: list, info, type, find, echo, pub, hz, bw, delay"),
+    (("topic",), (), None, "ROS topics"),
     (("topic", "list"), (), "topic.list", "list the topics of the ROS graph"),
     (("topic", "info"), (), "topic.info", "a topic's type and endpoints (-v: QoS and compatibility checks)"),
     (("topic", "type"), (), "topic.type", "print a topic's type"),
@@ -40,20 +41,20 @@ COMMANDS = (
     (("topic", "hz"), (), "topic.hz", "the publishing rate of topics (from sequence numbers, losses counted)"),
     (("topic", "bw"), (), "topic.bw", "the bandwidth a topic uses (true serialised sizes)"),
     (("topic", "delay"), (), "topic.delay", "delay between header stamps and reception"),
-    (("node",), (), None, "ROS nodes: list, info"),
+    (("node",), (), None, "ROS nodes"),
     (("node", "list"), (), "node.list", "list the nodes of the ROS graph"),
     (("node", "info"), (), "node.info", "what a node publishes, subscribes, serves and calls"),
-    (("service",), (), None, "ROS services: list, type, find, call"),
+    (("service",), (), None, "ROS services"),
     (("service", "list"), (), "service.list", "list the services of the ROS graph"),
     (("service", "type"), (), "service.type", "print a service's type"),
     (("service", "find"), (), "service.find", "list the services of a given type"),
     (("service", "call"), (), "service.call", "call a service"),
-    (("action",), (), None, "ROS actions: list, info, type, send_goal"),
+    (("action",), (), None, "ROS actions"),
     (("action", "list"), (), "action.list", "list the actions of the ROS graph"),
     (("action", "info"), (), "action.info", "the servers and clients of an action"),
     (("action", "type"), (), "action.type", "print an action's type"),
     (("action", "send_goal"), (), "action.send_goal", "send a goal to an action server and wait for its result"),
-    (("param",), (), None, "ROS parameters: list, get, describe, dump, set, delete, load"),
+    (("param",), (), None, "ROS parameters"),
     (("param", "list"), (), "param.list", "list the parameters of one node or of every node"),
     (("param", "get"), (), "param.get", "print a parameter's value"),
     (("param", "describe"), (), "param.describe", "print a parameter's descriptor"),
@@ -61,16 +62,16 @@ COMMANDS = (
     (("param", "set"), (), "param.set", "set parameters of a node"),
     (("param", "delete"), (), "param.delete", "delete parameters of a node"),
     (("param", "load"), (), "param.load", "set a node's parameters from a parameter file (as param dump writes it)"),
-    (("interface",), (), None, "ROS interfaces from the ament index: list, packages, package, show"),
+    (("interface",), (), None, "ROS interfaces from the ament index"),
     (("interface", "list"), (), "interface.list", "list the messages, services and actions installed"),
     (("interface", "packages"), (), "interface.packages", "list the packages that define interfaces"),
     (("interface", "package"), (), "interface.package", "list the interfaces of one package"),
     (("interface", "show"), (), "interface.show", "print an interface definition, nested types expanded"),
     (("interface", "proto"), (), "interface.proto", "print a YAML prototype of a message, request or goal"),
-    (("graph",), (), None, "the running ROS system as a whole: check, snapshot"),
+    (("graph",), (), None, "the running ROS system as a whole"),
     (("graph", "check"), (), "graph.check", "probe the running system against roc.toml's [check] expectations"),
     (("graph", "snapshot"), (), "graph.snapshot", "print the [check] expectations the running system meets now"),
-    (("frame",), (), None, "tf frames and transforms: list, echo, tree, monitor, pub, convert"),
+    (("frame",), (), None, "tf frames and transforms"),
     (("frame", "list"), (), "frame.list", "every tf frame: parent, static or dynamic, rate, age, publishers"),
     (("frame", "echo"), (), "frame.echo", "the transform between two frames (like tf2_echo)"),
     (("frame", "tree"), (), "frame.tree", "the tf tree as text, DOT, SVG, PNG or PDF"),
@@ -78,18 +79,18 @@ COMMANDS = (
     (("frame", "pub"), (), "frame.pub", "publish a transform, static or at a rate (like static_transform_publisher)"),
     (("frame", "convert"), (), "frame.convert", "convert rotations between representations; compose and invert transforms"),
     (("bridge",), (), "bridge.command", "bridge topics from one ROS domain into another (like domain_bridge)"),
-    (("bag",), (), None, "rosbag2 bags (MCAP, sqlite3): info, record, play, convert, reindex, list"),
+    (("bag",), (), None, "rosbag2 bags (MCAP, sqlite3)"),
     (("bag", "info"), (), "bag.info", "what a bag holds (like ros2 bag info)"),
     (("bag", "record"), (), "bag.record", "record topics and services into a bag (like ros2 bag record)"),
     (("bag", "play"), (), "bag.play", "play a bag back (like ros2 bag play)"),
     (("bag", "convert"), (), "bag.convert", "rewrite bags with other storage, splits, compression or topics"),
     (("bag", "reindex"), (), "bag.reindex", "rebuild a bag's metadata.yaml from its files (after a crash)"),
     (("bag", "list"), (), "bag.list", "the storage and compression formats roc supports"),
-    (("daemon",), (), None, "the roc daemon (a warm graph participant): start, stop, status"),
+    (("daemon",), (), None, "the roc daemon (a warm graph participant)"),
     (("daemon", "start"), (), "daemon.start", "start the roc daemon of this discovery environment"),
     (("daemon", "stop"), (), "daemon.stop", "stop the roc daemon of this discovery environment"),
     (("daemon", "status"), (), "daemon.status", "whether the roc daemon of this environment runs"),
-    (("idl",), (), None, "interface definitions: convert between protobuf and ROS 2 messages"),
+    (("idl",), (), None, "interface definitions, converted between protobuf and ROS 2 messages"),
     (("idl", "protobuf"), (), "idl.protobuf", "convert .proto files to .msg files, or .msg files to .proto"),
     (("completion",), (), "completion", "print a shell completion script: bash, zsh or fish"),
 )
@@ -122,6 +123,14 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message: str):
         self.exit(EXIT_USAGE, f"roc: error: {message} (see '{self.prog} --help')\n")
+
+    def _check_value(self, action: argparse.Action, value) -> None:
+        """A command or verb that does not exist gets the hint a mistyped option gets (the closest
+        name), in place of argparse's list of every choice."""
+        if isinstance(action, argparse._SubParsersAction) and value not in action.choices:
+            hint = did_you_mean(value, action.choices, count=1) or f"choose from {', '.join(action.choices)}"
+            raise argparse.ArgumentError(None, f"unknown command '{value}'; {hint}")
+        super()._check_value(action, value)  # type: ignore[misc]
 
     def parse_args(self, args=None, namespace=None):
         """Unknown arguments are reported by the parser of the command they were given to."""
@@ -180,6 +189,8 @@ def build_parser(argv: list[str] | None = None) -> Parser:
         (): parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     }
     for path, aliases, module, help_text in COMMANDS:
+        if module is None:
+            help_text = f"{help_text}: {', '.join(verbs(path))}"
         sub = groups[path[:-1]].add_parser(path[-1], aliases=list(aliases), help=help_text, description=help_text)
         if module is None:
             groups[path] = sub.add_subparsers(dest="_".join(path) + "_command", metavar="COMMAND", parser_class=Parser)
@@ -193,6 +204,11 @@ def build_parser(argv: list[str] | None = None) -> Parser:
             leaves[path] = sub
     parser.leaves = leaves
     return parser
+
+
+def verbs(group: tuple[str, ...]) -> list[str]:
+    """The names of a group's commands, in the table's order."""
+    return [path[-1] for path, _, _, _ in COMMANDS if path[:-1] == group]
 
 
 def command_module(name: str):

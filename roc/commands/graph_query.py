@@ -24,11 +24,10 @@ def ask(args: argparse.Namespace, method: str, params: dict[str, Any] | None = N
 
 
 def publisher_wait(args: argparse.Namespace) -> float:
-    """How long a stream waits for a topic's publishers to be discovered: nothing through the warm
-    daemon, the discovery period in a fresh participant."""
-    if args.spin_time is not None:
-        return args.spin_time
-    return DEFAULT_SPIN_TIME if args.no_daemon else 0.0
+    """How long a stream waits for a topic's publishers to be discovered (``--spin-time``, default the
+    discovery period): a fresh participant must discover them, and so must the warm daemon when a
+    publisher has only just started. A topic the graph already knows costs no wait."""
+    return args.spin_time if args.spin_time is not None else DEFAULT_SPIN_TIME
 
 
 def snapshot(args: argparse.Namespace, kind: str) -> list[dict[str, Any]]:

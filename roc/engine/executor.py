@@ -75,12 +75,14 @@ def execute(
     handlers: Iterable[Handler],
     workers: int,
     continue_on_error: bool = False,
+    kind: str = "build",
 ) -> RunResult:
     """Run ``tasks`` respecting their dependencies with at most ``workers`` at once (0: no limit).
 
     Without ``continue_on_error`` the first failure stops the running tasks (aborted) and starts no
-    more; with it, only the tasks depending on a failed one are skipped. Ctrl+C and SIGTERM stop every
-    running process tree and end the run with ``interrupted`` set. A handler that raises is reported
+    more; with it, only the tasks depending on a failed one are skipped. ``kind`` is the run's own kind
+    of task (``build``, ``test``, ``probe``), which the final RunFinished event carries. Ctrl+C and
+    SIGTERM stop every running process tree and end the run with ``interrupted`` set. A handler that raises is reported
     on stderr and left out of the rest of the run (the run goes on), except for a closed stdout
     (BrokenPipeError), which stops the run and is raised at its end.
     """
@@ -193,7 +195,7 @@ def execute(
             signal.signal(sig, handler)
     done = set(result.finished) | set(result.failed) | set(result.aborted) | set(result.skipped)
     result.not_started = [n for n in by_name if n not in done]
-    handle(RunFinished("", interrupted=result.interrupted, not_started=tuple(result.not_started)))
+    handle(RunFinished("", kind, interrupted=result.interrupted, not_started=tuple(result.not_started)))
     if failure is not None:
         raise failure
     return result

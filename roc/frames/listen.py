@@ -6,7 +6,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-from roc.errors import UsageError
+from roc.errors import RocError
 from roc.frames.buffer import Buffer
 from roc.frames.transform import Transform
 from roc.ros.client import stream
@@ -18,7 +18,7 @@ def require_tf2_msgs() -> None:
     try:
         message_class(TF_TYPE)
     except UnknownTypeError:
-        raise UsageError("tf2_msgs is not installed (the ROS 2 wheels from PyPI lack it): source a ROS "
+        raise RocError("tf2_msgs is not installed (the ROS 2 wheels from PyPI lack it): source a ROS "
                          "install that has it, or build roc's example workspace (workspaces/example, which has a "
                          "tf2_msgs package) with 'roc work build' and source its install/setup.bash") from None
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Collection
 from typing import TextIO
 
 from roc.engine.events import (
@@ -32,6 +33,12 @@ def format_duration(seconds: float) -> str:
 
 def _plural(n: int, word: str) -> str:
     return f"{n} {word}{'' if n == 1 else 's'}"
+
+
+def _names(labels: Collection[str]) -> str:
+    """Labels in a summary line, sorted: space-separated as colcon lists packages, or comma-separated
+    when a label has a space of its own (a probe: ``node /ghost_node``)."""
+    return (", " if any(" " in label for label in labels) else " ").join(sorted(labels))
 
 
 def _count(labels: list[str], noun: str = "package") -> str:
@@ -154,21 +161,21 @@ class ConsoleHandler:
         total = format_duration(time.monotonic() - self.started_at)
         lines = ["", f"Summary: {_count(self.finished + self.cached, self.noun)} finished [{total}]"]
         if self.cached:
-            names = f": {' '.join(sorted(self.cached))}" if len(self.cached) <= 10 else ""
+            names = f": {_names(self.cached)}" if len(self.cached) <= 10 else ""
             lines.append(f"  {_count(self.cached, self.noun)} {self.cached_label}{names}")
         if self.failed:
-            lines.append(f"  {_count(self.failed, self.noun)} failed: {' '.join(sorted(self.failed))}")
+            lines.append(f"  {_count(self.failed, self.noun)} failed: {_names(self.failed)}")
         if self.aborted:
-            lines.append(f"  {_count(self.aborted, self.noun)} aborted: {' '.join(sorted(self.aborted))}")
+            lines.append(f"  {_count(self.aborted, self.noun)} aborted: {_names(self.aborted)}")
         if self.skipped:
             causes = " ".join(f"{name} (needs {cause})" for name, cause in sorted(self.skipped.items()))
             lines.append(f"  {_count(list(self.skipped), self.noun)} skipped because a dependency failed: {causes}")
         with_stderr = sorted(self._labels.get(key, key) for key in self._stderr)
         if with_stderr:
-            lines.append(f"  {_count(with_stderr, self.noun)} had stderr output: {' '.join(with_stderr)}")
+            lines.append(f"  {_count(with_stderr, self.noun)} had stderr output: {_names(with_stderr)}")
         if self.test_failures:
             lines.append(f"  {_count(self.test_failures, self.noun)} had test failures: "
-                         f"{' '.join(sorted(self.test_failures))}")
+                         f"{_names(self.test_failures)}")
         if event.not_started:
             lines.append(f"  {_count(list(event.not_started), self.noun)} not processed")
         if event.interrupted:

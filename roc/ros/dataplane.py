@@ -113,17 +113,19 @@ def echo(graph, params: dict[str, Any]) -> Events:
     lost}]}`` with what arrived since the last event (``lost``: messages the publisher's sequence
     numbers say never arrived), ``{"event": "subscribed", "type"}`` first and heartbeats in between.
     Params: ``topic``, ``wait`` (seconds to wait for a publisher to be discovered), ``type`` (else the
-    graph's), ``qos`` (see qos_profile), ``timeout`` (seconds for the first message; then ``{"event":
-    "timeout"}`` ends the stream)."""
-    topic = params["topic"]
+    graph's), ``qos`` (see qos_profile), ``timeout`` (seconds for the first message, counted from the
+    start, the wait for a publisher included; then ``{"event": "timeout"}`` ends the stream)."""
+    topic, timeout = params["topic"], params.get("timeout")
+    started = time.monotonic()
+    if timeout is not None:
+        params = {**params, "wait": min(params.get("wait", 0.0), timeout)}
     cls, type_name, found = yield from _topic_class(graph, topic, params, wait_for_type=False)
     receiver = Receiver(graph.node)
     try:
         receiver.subscribe(topic, cls, topic, subscription_profile(params.get("qos", {}), found))
         yield {"event": "subscribed", "type": type_name}
         last_sequence: dict[str, int] = {}  # by publisher gid
-        timeout = params.get("timeout")
-        deadline = time.monotonic() + timeout if timeout is not None else None
+        deadline = started + timeout if timeout is not None else None
         while True:
             batch = receiver.batch(HEARTBEAT_SECONDS, MAX_BATCH)
             if not batch:

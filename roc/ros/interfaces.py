@@ -1,16 +1,15 @@
-"""Interfaces (messages, services, actions) from the ament index of every prefix on AMENT_PREFIX_PATH,
-and their definitions with nested types expanded as ``ros2 interface show`` prints them. Plain files:
-no rclpy, no daemon."""
+"""Interfaces (messages, services, actions) from the ament index of every prefix roc looks in
+(``roc.environment.ament_prefixes``: AMENT_PREFIX_PATH and roc's own prefix), and their definitions
+with nested types expanded as ``ros2 interface show`` prints them. Plain files: no rclpy, no daemon."""
 
 from __future__ import annotations
 
-import os
 import re
-import sys
 from pathlib import Path
 
-from roc.environment import path_list
+from roc.environment import ament_prefixes
 from roc.errors import RocError
+from roc.ros.types import TypeNameError
 
 KINDS = ("msg", "srv", "action")
 PRIMITIVES = {"bool", "byte", "char", "float32", "float64", "int8", "uint8", "int16", "uint16", "int32", "uint32",
@@ -18,19 +17,10 @@ PRIMITIVES = {"bool", "byte", "char", "float32", "float64", "int8", "uint8", "in
 SEPARATOR = "---"
 
 
-def prefixes() -> list[Path]:
-    """AMENT_PREFIX_PATH; when unset, roc's own prefix if it holds an ament index (ROS from wheels)."""
-    value = os.environ.get("AMENT_PREFIX_PATH")
-    if value:
-        return [Path(p) for p in path_list(value)]
-    prefix = Path(sys.prefix)
-    return [prefix] if (prefix / "share" / "ament_index" / "resource_index").is_dir() else []
-
-
 def _resources(kind: str) -> dict[str, Path]:
     """Resource name -> the first prefix that registers it (earlier prefixes overlay later ones)."""
     found: dict[str, Path] = {}
-    for prefix in prefixes():
+    for prefix in ament_prefixes():
         directory = prefix / "share" / "ament_index" / "resource_index" / kind
         if directory.is_dir():
             for entry in directory.iterdir():
@@ -72,7 +62,7 @@ def package_interfaces(package: str | None = None) -> dict[str, dict[str, list[s
 def definition_path(type_name: str) -> Path:
     parts = type_name.split("/")
     if len(parts) != 3 or not all(parts) or ".." in parts:
-        raise RocError(f"Invalid name '{type_name}'. Expected three parts separated by '/'")
+        raise TypeNameError(f"Invalid name '{type_name}'. Expected three parts separated by '/'")
     prefix = _resources("packages").get(parts[0])
     if prefix is None:
         raise RocError(f"Unknown package '{parts[0]}'")

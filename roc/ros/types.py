@@ -14,9 +14,9 @@ from functools import cache
 from pathlib import Path
 from typing import Any, TypeAlias
 
-from roc.environment import path_list
-from roc.errors import UsageError
-from roc.messages import did_you_mean
+from roc.environment import ament_prefixes
+from roc.errors import RocError, UsageError
+from roc.messages import PACKAGE_NAME_CUTOFF, did_you_mean
 
 KINDS = ("msg", "srv", "action")
 KIND_NOUNS = {"msg": "message", "srv": "service", "action": "action"}
@@ -26,8 +26,14 @@ DEFINITION_SUFFIXES = {"msg": ".msg", "srv": ".srv", "action": ".action"}
 TF_TYPE = "tf2_msgs/msg/TFMessage"  # what /tf and /tf_static carry
 
 
-class UnknownTypeError(UsageError):
-    """An interface type that is not installed, or a malformed type name."""
+class UnknownTypeError(RocError):
+    """An interface type that is not installed: exit 1 from every verb (as from ros2 and from
+    ``roc interface show``), since the name may be right and the environment lack it."""
+
+
+class TypeNameError(UsageError):
+    """A type name that no installed type could have (malformed), or a type of the wrong kind for the
+    verb: a usage error (exit 2) from every verb."""
 
 
 # A class rosidl generated (a message, service or action, or one of their parts): dynamic, with no
@@ -41,7 +47,7 @@ def split_type_name(name: str) -> tuple[str, str | None, str]:
         return parts[0], parts[1], parts[2]
     if len(parts) == 2 and all(parts):
         return parts[0], None, parts[1]
-    raise UnknownTypeError(
+    raise TypeNameError(
         f"invalid type name '{name}': expected pkg/msg/Type, pkg/srv/Type, pkg/action/Type or pkg/Type")
 
 
@@ -93,7 +99,7 @@ def _resolve(name: str, kind: str | None) -> InterfaceClass:
         found = _lookup(package, candidate, short)
         if found is not None:
             if kind and interface_kind(found) != kind:
-                raise UnknownTypeError(
+                raise TypeNameError(
                     f"{type_name(found)} is a {KIND_NOUNS[interface_kind(found)]}, not a {KIND_NOUNS[kind]}")
             return found
     raise UnknownTypeError(_unknown_message(name, package, kinds, short))
@@ -101,7 +107,7 @@ def _resolve(name: str, kind: str | None) -> InterfaceClass:
 
 def resolve_type(name: str, kind: str | None = None) -> InterfaceClass:
     """The class of an interface type; ``kind`` (msg, srv, action) also requires that kind and is
-    the default for ``pkg/Type``. Raises UnknownTypeError with a hint."""
+    the default for ``pkg/Type``. Raises UnknownTypeError with a hint, or TypeNameError."""
     return _resolve(name, kind)
 
 
@@ -119,14 +125,10 @@ def action_class(name: str) -> InterfaceClass:
 
 # ---- errors -----------------------------------------------------------------------------------
 
-def _prefixes() -> list[Path]:
-    return [Path(p) for p in path_list(os.environ.get("AMENT_PREFIX_PATH"))]
-
-
 def interface_packages() -> set[str]:
-    """Interface packages in the ament index of the sourced prefixes (for did-you-mean hints)."""
+    """Interface packages in the ament index of the prefixes roc looks in (for did-you-mean hints)."""
     names: set[str] = set()
-    for prefix in _prefixes():
+    for prefix in ament_prefixes():
         index = prefix / "share" / "ament_index" / "resource_index" / "rosidl_interfaces"
         if index.is_dir():
             names.update(entry.name for entry in index.iterdir())
@@ -140,8 +142,8 @@ def _package_types(package: str, kind: str) -> list[str]:
     return [n for n, v in vars(module).items() if isinstance(v, type) and "_" not in n]
 
 
-def _did_you_mean(word: str, choices: list[str] | set[str]) -> str:
-    hint = did_you_mean(word, choices)
+def _did_you_mean(word: str, choices: list[str] | set[str], cutoff: float = 0.6) -> str:
+    hint = did_you_mean(word, choices, cutoff=cutoff)
     return f" ({hint})" if hint else ""
 
 
@@ -149,7 +151,7 @@ def _unknown_message(name: str, package: str, kinds: list[str], short: str) -> s
     nouns = " or ".join(KIND_NOUNS[k] for k in kinds)
     hint = _unsourced_hint(package, kinds, short)
     if not any(_interface_module(package, kind) for kind in KINDS):
-        guess = "" if hint else _did_you_mean(package, interface_packages())
+        guess = "" if hint else _did_you_mean(package, interface_packages(), PACKAGE_NAME_CUTOFF)
         return f"unknown {nouns} type '{name}': no interface package '{package}' is installed{guess}" + (
             hint or "; install it or source the workspace that builds it")
     known = [t for k in kinds for t in _package_types(package, k)]
@@ -175,7 +177,7 @@ def _unsourced_hint(package: str, kinds: list[str], short: str) -> str:
     AMENT_PREFIX_PATH."""
     from roc.workspace.root import find_workspace_root
 
-    sourced = {p.resolve() for p in _prefixes() if p.exists()}
+    sourced = {p.resolve() for p in ament_prefixes() if p.exists()}
     root = find_workspace_root(Path.cwd())
     install = root / "install" if root else None
     if install and install.is_dir():

@@ -11,6 +11,7 @@ import shlex
 from functools import lru_cache
 from pathlib import Path
 
+from roc.environment.chain import Underlay
 from roc.environment.dsv import Operation, resolve_operations
 from roc.fsutil import write_text_atomic
 from roc.templates import template_environment
@@ -71,14 +72,15 @@ def write_package_scripts(prefix: Path, package: str, hooks: list[str]) -> None:
         write_text_atomic(share / f"package.{shell}", render("package.shell.j2", package=package, shell=shell))
 
 
-def write_install_scripts(base: Path, packages: list[str], merged: bool, underlays: list[str]) -> None:
-    """Install-level ``local_setup.*`` (``packages`` in dependency order) and ``setup.*`` scripts."""
+def write_install_scripts(base: Path, packages: list[str], merged: bool, underlays: list[Underlay]) -> None:
+    """Install-level ``local_setup.*`` (``packages`` in dependency order) and ``setup.*`` scripts, the
+    latter chaining ``underlays`` (highest priority first: they are applied in reverse order)."""
     for shell in ("sh", "ps1"):
         write_text_atomic(base / f"local_setup.{shell}", render(f"local_setup.{shell}.j2", base=base,
                                                                 packages=packages, merged=merged))
     for shell in ("bash", "zsh"):
         write_text_atomic(base / f"local_setup.{shell}", render("local_setup.shell.j2", shell=shell))
-    chain = [u for u in reversed(underlays) if Path(u) != base]
+    chain = list(reversed(underlays))
     for shell in SHELLS:
         write_text_atomic(base / f"setup.{shell}", render("setup.sh.j2", shell=shell, base=base, underlays=chain))
     write_text_atomic(base / "setup.ps1", render("setup.ps1.j2", underlays=chain))

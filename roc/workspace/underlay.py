@@ -1,11 +1,12 @@
-"""Packages of the underlay workspaces (``AMENT_PREFIX_PATH``, ``COLCON_PREFIX_PATH``), and the check
-that colcon-override-check makes: building a package that an underlay also has, while another underlay
-package uses it, is risky (include order, API/ABI compatibility), so it is reported unless allowed
-with ``--allow-overriding``."""
+"""Packages of the underlay workspaces (``AMENT_PREFIX_PATH``, ``COLCON_PREFIX_PATH``), and two checks
+before a build: colcon-override-check's (building a package that an underlay also has, while another
+underlay package uses it, is risky: include order, API/ABI compatibility; reported unless allowed with
+``--allow-overriding``), and dependencies that exist nowhere (likely typos)."""
 
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 
@@ -96,3 +97,21 @@ def override_warning(overridden: Mapping[str, list[Path]]) -> str:
             "If another underlay package uses it, the overriding package must be API and ABI compatible with "
             "the one it replaces.\nIf you understand the risks, add to the command line: --allow-overriding "
             + " ".join(overridden))
+
+
+# What a ROS package may be called (REP 144). A rosdep key of a system package often cannot be
+# (python3-numpy, libboost-dev), and is never reported as missing.
+PACKAGE_NAME = re.compile(r"[a-z][a-z0-9_]*")
+
+
+def missing_dependencies(packages: Iterable, known: set[str]) -> dict[str, list[str]]:
+    """{name: [packages depending on it]} for each dependency of ``packages`` (roc.workspace.package
+    Packages) that is not ``known`` (the workspace's and the underlays' packages) and could be a ROS
+    package's name."""
+    missing: dict[str, list[str]] = {}
+    for package in packages:
+        for name in sorted(package.direct_dependencies()):
+            if name not in known and PACKAGE_NAME.fullmatch(name):
+                missing.setdefault(name, []).append(package.name)
+    return missing
+

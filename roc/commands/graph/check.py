@@ -99,7 +99,7 @@ def run(args: argparse.Namespace) -> int:
             started = time.monotonic()
             tasks = [Task(name=e.label, dependencies=set(), action=partial(run_probe, e, session), kind=KIND)
                      for e in checks.expectations]
-            result = execute(tasks, handlers(), args.parallel_workers, continue_on_error=True)
+            result = execute(tasks, handlers(), args.parallel_workers, continue_on_error=True, kind=KIND)
             if metrics is not None:
                 metrics.rounds.inc()
             if result.interrupted:

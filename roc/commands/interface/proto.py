@@ -6,7 +6,6 @@ from __future__ import annotations
 import argparse
 
 from roc.cli.options import add_format_argument
-from roc.errors import RocError, UsageError
 from roc.render import render
 from roc.ros.messages import dict_to_yaml, prototype
 
@@ -18,10 +17,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    try:
-        data = prototype(args.type)
-    except UsageError as error:  # an unknown type is a failure (exit 1), as for every interface verb
-        raise RocError(str(error)) from None
+    data = prototype(args.type)
     text = dict_to_yaml(data)
     render(data, args.format, [text if args.no_quotes else f'"{text}"'])
     return 0

@@ -55,13 +55,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_graph_arguments(parser)
 
 
+def named_reason(name: str, reason: str) -> str:
+    """The node's reason, naming the parameter where rclpy leaves its list empty (``Invalid access to
+    undeclared parameter(s): []``)."""
+    return reason.replace("parameter(s): []", f"parameter(s): {name}")
+
+
 def report(args: argparse.Namespace, results: list[dict[str, Any]], succeeded: Callable[[str], str],
            failed: Callable[[str], str]) -> int:
     """ros2's line per parameter (``succeeded(name)``; ``failed(name)`` and the node's reason): the
     successes on stdout, the failures on stderr. Exit 1 when one failed (ros2 exits 0)."""
     render(results, args.format, [succeeded(r["name"]) for r in results if r["successful"]])
     if args.format == "text":
-        print_lines([failed(r["name"]) + (f": {r['reason']}" if r["reason"] else "")
+        print_lines([failed(r["name"]) + (f": {named_reason(r['name'], r['reason'])}" if r["reason"] else "")
                      for r in results if not r["successful"]], sys.stderr)
     return 0 if all(r["successful"] for r in results) else 1
 

@@ -70,7 +70,8 @@ def run(args: argparse.Namespace) -> int:
     limit = None if args.full_length else args.truncate_length
     options = {"no_arr": args.no_arr, "no_str": args.no_str, "truncate_length": limit}
     params = {"topic": args.topic_name, "type": args.message_type, "qos": qos_options(args),
-              "wait": publisher_wait(args),
+              # a publisher that has only just started is waited for: up to --timeout when given
+              "wait": args.timeout if args.timeout is not None else publisher_wait(args),
               "timeout": args.timeout}
     lost_total = 0
     type_name = args.message_type

@@ -16,6 +16,19 @@ from roc.ros.client import stream
 from roc.ros.messages import fill_message, parse_values, value_to_data
 from roc.ros.types import message_class
 
+WAITING_LINES = 5  # ros2's waiting line, once a second, before roc says once how to stop waiting
+
+
+def waiting_text(count: int, wanted: int) -> str:
+    """What the ``count``-th waiting event (one a second, from 1) prints: ros2's line, then instead of
+    repeating it for ever, once how to stop waiting."""
+    if count < WAITING_LINES:
+        return f"Waiting for at least {wanted} matching subscription(s)...\n"
+    if count == WAITING_LINES:
+        return (f"Still waiting for {wanted} matching subscription(s) after {count - 1} s, until they appear: "
+                "Ctrl+C stops, '-w 0' publishes without waiting, '--max-wait-time-secs SECONDS' gives up\n")
+    return ""
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("topic_name", help="name of the topic to publish to, e.g. /chatter")
@@ -75,13 +88,15 @@ def run(args: argparse.Namespace) -> int:
         local["prepare"] = lambda: _restamp(message, stamps)
     if args.node_name:
         local["node_name"] = args.node_name
+    waited = 0
     for event in stream("publish", params, use_daemon=not args.no_daemon and not local, **local):
         kind = event["event"]
         if args.format == "json":
             print_json_line({"topic": args.topic_name, **event,
                              **({"message": value_to_data(message)} if kind == "published" else {})})
         elif kind == "waiting":
-            print_text(f"Waiting for at least {event['subscriptions']} matching subscription(s)...\n")
+            waited += 1
+            print_text(waiting_text(waited, event["subscriptions"]))
         elif kind == "started":
             print_text("publisher: beginning loop\n")
         elif kind == "published" and args.print_every and event["count"] % args.print_every == 0:

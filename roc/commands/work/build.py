@@ -100,6 +100,21 @@ def warn_about_overrides(args: argparse.Namespace, workspace, install_base: Path
         warn(override_warning(overridden))
 
 
+def warn_about_missing_dependencies(workspace) -> None:
+    """One warning per dependency of the selected packages that neither the workspace nor an underlay
+    has (colcon builds on silently): a typo, most likely, or a system dependency."""
+    from roc.builder.environment import base_environment
+    from roc.messages import PACKAGE_NAME_CUTOFF, did_you_mean, warn
+    from roc.workspace.underlay import missing_dependencies, underlay_packages
+
+    known = set(workspace.by_name) | set(underlay_packages(base_environment()))
+    selected = [workspace.by_name[name] for name in sorted(workspace.selected)]
+    for name, users in missing_dependencies(selected, known).items():
+        hint = did_you_mean(name, known, count=1, cutoff=PACKAGE_NAME_CUTOFF) or (
+            "a typo? (a system dependency that rosdep installs is fine)")
+        warn(f"'{name}', a dependency of {', '.join(users)}, is in neither the workspace nor an underlay; {hint}")
+
+
 def _explain(args: argparse.Namespace, workspace, options) -> int:
     from roc.builder.uptodate import explain
     from roc.engine.events import task_key
@@ -150,6 +165,7 @@ def run(args: argparse.Namespace) -> int:
     if args.explain:
         return _explain(args, workspace, options)
     warn_about_overrides(args, workspace, options.install_base)
+    warn_about_missing_dependencies(workspace)
     with build_lock(options.build_base):
         prepare_build_base(options.build_base)
         prepare_install_base(options.install_base, args.merge_install)

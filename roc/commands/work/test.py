@@ -89,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
     from roc.commands.work.build import skip_configured_packages
     from roc.engine.executor import execute
     from roc.engine.store import DurationStore
-    from roc.testing.plan import plan_tests
+    from roc.testing.plan import KIND, plan_tests
     from roc.workspace.load import load_workspace
 
     switches = handler_switches(args.event_handlers)
@@ -115,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
                     failures, durations]
         try:
             tasks = plan_tests(workspace, options, durations.durations, force=args.force, use_cache=not args.no_cache)
-            result = execute(tasks, handlers, workers, continue_on_error=not args.abort_on_error)
+            result = execute(tasks, handlers, workers, continue_on_error=not args.abort_on_error, kind=KIND)
         finally:
             for handler in handlers:
                 getattr(handler, "close", lambda: None)()

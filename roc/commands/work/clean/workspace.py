@@ -43,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def remove_paths(paths: list[Path], yes: bool) -> int:
-    """List, confirm and remove (colcon clean's messages)."""
+    """List, confirm and remove (colcon clean's messages), then say what was removed (colcon says nothing)."""
     from roc.builder.clean import remove
     from roc.cli.confirm import confirm
 
@@ -57,4 +57,5 @@ def remove_paths(paths: list[Path], yes: bool) -> int:
             return 0
     for path in paths:
         remove(path)
+    print_lines(["Removed:", *(f"     {os.path.relpath(path)}" for path in paths)])
     return 0
