@@ -73,7 +73,7 @@ def source_parts(stamps: FileStamps) -> dict[str, str]:
 
 
 # Files colcon and roc write again on every build of a package, whatever changed.
-_REGENERATED = re.compile(r"share/[^/]+/(hook/|package\.|local_setup\.)|share/colcon-core/|\.pyc$")
+REGENERATED_INSTALL_FILES = re.compile(r"share/[^/]+/(hook/|package\.|local_setup\.)|share/colcon-core/|\.pyc$")
 
 
 def _newest(prefix: str) -> int:
@@ -83,7 +83,7 @@ def _newest(prefix: str) -> int:
     for dirpath, _, filenames in os.walk(prefix):
         for name in filenames:
             path = os.path.join(dirpath, name)
-            if not _REGENERATED.search(os.path.relpath(path, prefix)):
+            if not REGENERATED_INSTALL_FILES.search(os.path.relpath(path, prefix)):
                 try:
                     newest = max(newest, os.stat(path).st_ctime_ns)
                 except OSError:

@@ -33,9 +33,13 @@ def read_state(build_dir: Path) -> dict:
     return read_record(build_dir / STATE_FILE, "damaged build state; the package will be rebuilt")
 
 
-def write_state(build_dir: Path, fingerprint: str | None, files: dict, parts: dict | None = None) -> None:
-    """Record ``fingerprint`` (made of ``parts``) as built; None: not up to date (a build started)."""
+def write_state(build_dir: Path, fingerprint: str | None, files: dict, parts: dict | None = None,
+                remote_key: str | None = None) -> None:
+    """Record ``fingerprint`` (made of ``parts``) as built; None: not up to date (a build started).
+    ``remote_key``: the package's remote cache key (roc.remote_cache.keys), when it has one."""
     state = {"fingerprint": fingerprint, "files": files, "parts": parts}
+    if remote_key:
+        state["remote_key"] = remote_key
     write_text_atomic(build_dir / STATE_FILE, json.dumps(state, separators=(",", ":")))
 
 

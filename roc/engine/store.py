@@ -21,7 +21,7 @@ class DurationStore:
             self.durations = {}  # missing or damaged: schedule without weights
 
     def __call__(self, event: Event) -> None:
-        if isinstance(event, TaskFinished) and not event.cached:
+        if isinstance(event, TaskFinished) and not (event.cached or event.restored):
             self.durations[event.key] = round(event.duration, 3)
 
     def save(self) -> None:

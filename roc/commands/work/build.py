@@ -37,6 +37,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="build nothing: print each selected package, in build order, and why it would be built")
     add("--no-cache", action="store_true",
         help="neither skip up-to-date packages nor record fingerprints for the next build")
+    remote = parser.add_argument_group("remote build cache (docs/caching.md)")
+    remote.add_argument("--remote-cache", metavar="URL",
+                        help="restore packages built elsewhere from this cache (http(s):// WebDAV or "
+                             "bazel-remote, s3://BUCKET/PREFIX) instead of building them (default: "
+                             "$ROC_REMOTE_CACHE)")
+    remote.add_argument("--remote-cache-mode", choices=("read", "read-write", "off"),
+                        help="read: restore only (default); read-write: also upload what is built (CI); "
+                             "off: do not use it (default: $ROC_REMOTE_CACHE_MODE, else read)")
+    remote.add_argument("--remote-cache-timeout", type=float, metavar="SECONDS",
+                        help="give up on a server that does not answer within this time, and build "
+                             "locally (default: 10)")
     cmake = parser.add_argument_group("cmake and ament_cmake packages")
     cmake.add_argument("--cmake-target", help="build this target instead of the default one (no install)")
     cmake.add_argument("--cmake-target-skip-unavailable", action="store_true",
@@ -100,12 +111,37 @@ def warn_about_overrides(args: argparse.Namespace, workspace, install_base: Path
         warn(override_warning(overridden))
 
 
+def _remote_cache(args: argparse.Namespace, workspace, options):
+    """The run's RemoteCache, or None when the remote cache is off or not configured. The environment
+    wins over roc.toml; the command line over both."""
+    from roc.remote_cache.settings import URL_VARIABLE, remote_settings
+
+    config = getattr(args, "configuration", None)
+    url = args.remote_cache
+    if config is not None and config.from_configuration(args, "remote_cache") and os.environ.get(URL_VARIABLE):
+        url = None
+    settings = remote_settings(url, args.remote_cache_mode, args.remote_cache_timeout)
+    if settings is None:
+        return None
+    if settings.url.startswith("s3://"):
+        import importlib.util
+
+        if importlib.util.find_spec("boto3") is None:
+            raise UsageError("--remote-cache s3://...: boto3 is not installed; pip install 'roc[s3]' "
+                             "(or boto3) into roc's environment")
+    from roc.builder.artefact import Places
+    from roc.remote_cache.cache import RemoteCache
+
+    return RemoteCache(settings, Places(workspace.root, options.build_base, options.install_base),
+                       options.merge_install)
+
+
 def _explain(args: argparse.Namespace, workspace, options) -> int:
     from roc.builder.uptodate import explain
     from roc.engine.events import task_key
     from roc.render import print_json, print_lines
 
-    explained = explain(workspace, options)
+    explained = explain(workspace, options, _remote_cache(args, workspace, options))
     if args.output == "json":
         print_json([{"package": name, "kind": kind, "reasons": reasons} for kind, name, reasons in explained])
     else:
@@ -168,7 +204,8 @@ def _build(args, workspace, options, switches: dict[str, bool]) -> int:
     jobserver = Jobserver(options.jobs)
     handlers = [*output_handlers(args, switches, workspace.root, options.build_base), durations]
     try:
-        tasks = plan_build(workspace, options, jobserver, durations.durations)
+        tasks = plan_build(workspace, options, jobserver, durations.durations,
+                           _remote_cache(args, workspace, options))
         result = execute(tasks, handlers, workers, continue_on_error=args.continue_on_error)
     finally:
         jobserver.close()
