@@ -158,6 +158,8 @@ def _members_outside(tar: tarfile.TarFile, name: str, merged: bool) -> str | Non
     install = "install/" if merged else f"install/{name}/"
     for member in tar.getmembers():
         path = member.name.rstrip("/")
+        if path.startswith("/") or ".." in path.split("/"):
+            return member.name
         if not (path.startswith(install) or path == install.rstrip("/") or path.startswith(f"build/{name}/")
                 or path in ("install", "build", f"build/{name}")):
             return member.name
