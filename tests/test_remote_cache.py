@@ -229,7 +229,8 @@ def test_package_holding_its_prefix_is_restored_only_at_the_same_place(dav, tmp_
     elsewhere = checkout("elsewhere")
     built = roc("work", "build", "--remote-cache", f"{url}/placed", cwd=elsewhere, env=env)
     assert built.returncode == 0 and _started(elsewhere) == {"placed"}
-    assert (elsewhere / "install/placed/share/placed/where.txt").read_text().strip() == str(elsewhere / "install/placed")
+    where = elsewhere / "install" / "placed"
+    assert (where / "share" / "placed" / "where.txt").read_text().strip() == str(where)
     shutil.rmtree(ci / "install")
     shutil.rmtree(ci / "build")
     again = roc("work", "build", "--remote-cache", f"{url}/placed", cwd=ci, env=env)

@@ -185,3 +185,38 @@ def test_console_prints_restored_packages_and_counts_them(capsys) -> None:
     assert "Restored <<< a [from cache, 0.40s]" in text and "Starting >>> a" not in text
     assert "3 packages finished" in text and "(1 built, 1 restored from the remote cache, 1 up to date)" in text
     assert "roc: warning: b: remote cache x: down" in capsys.readouterr().err
+
+
+def test_compiler_cache_settings(tmp_path, monkeypatch) -> None:
+    from roc.builder.compiler_cache import compiler_cache
+
+    tools = tmp_path / "bin"
+    tools.mkdir()
+    for name in ("ccache", "sccache"):
+        (tools / name).write_text("#!/bin/sh\n")
+        (tools / name).chmod(0o755)
+    monkeypatch.setenv("PATH", str(tools))
+    monkeypatch.setenv("AWS_ENDPOINT_URL", "http://127.0.0.1:9000")
+    monkeypatch.delenv("AWS_REGION", raising=False)
+    monkeypatch.delenv("AWS_DEFAULT_REGION", raising=False)
+    root = tmp_path / "ws"
+    assert compiler_cache("none", None, root, root / "build") is None
+    read = remote_settings("https://u:p@cache.example/team", None, None)
+    ccache = compiler_cache("ccache", "cache-dir", root, root / "build", read)
+    assert ccache and ccache.cmake_arguments() == [f"-DCMAKE_C_COMPILER_LAUNCHER={tools}/ccache",
+                                                   f"-DCMAKE_CXX_COMPILER_LAUNCHER={tools}/ccache"]
+    assert ccache.environment == {"CCACHE_BASEDIR": str(root), "CCACHE_DIR": str(Path("cache-dir").absolute()),
+                                  "CCACHE_REMOTE_STORAGE": "https://cache.example/team/ccache|read-only"}
+    sccache = compiler_cache("sccache", None, root, root / "build", read)
+    assert sccache and sccache.environment["SCCACHE_WEBDAV_ENDPOINT"] == "https://cache.example/team"
+    assert sccache.environment["SCCACHE_WEBDAV_RW_MODE"] == "READ_ONLY"
+    assert len(sccache.environment["SCCACHE_SERVER_UDS"]) < 100 and "p" not in sccache.environment.get(
+        "SCCACHE_WEBDAV_PASSWORD", "")
+    s3 = compiler_cache("sccache", None, root, root / "build", remote_settings("s3://bucket/ci", "read-write", None))
+    assert s3 and {k: v for k, v in s3.environment.items() if k.startswith("SCCACHE_") and "UDS" not in k
+                   and "BASEDIRS" not in k} == {
+        "SCCACHE_BUCKET": "bucket", "SCCACHE_S3_KEY_PREFIX": "ci/sccache", "SCCACHE_S3_RW_MODE": "READ_WRITE",
+        "SCCACHE_REGION": "auto", "SCCACHE_ENDPOINT": "127.0.0.1:9000", "SCCACHE_S3_USE_SSL": "false"}
+    monkeypatch.setenv("PATH", str(tmp_path / "nothing"))
+    with pytest.raises(UsageError, match="'sccache' is not on PATH; install it"):
+        compiler_cache("sccache", None, root, root / "build")

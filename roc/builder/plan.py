@@ -33,18 +33,20 @@ from roc.workspace.load import Workspace
 from roc.workspace.package import Package
 
 if TYPE_CHECKING:
+    from roc.builder.compiler_cache import CompilerCache
     from roc.remote_cache.cache import RemoteCache
     from roc.remote_cache.keys import RemoteKeys
 
 
 def plan_build(
     workspace: Workspace, options: BuildOptions, jobserver: Jobserver | None, weights: dict[str, float],
-    remote: RemoteCache | None = None,
+    remote: RemoteCache | None = None, compiler: CompilerCache | None = None,
 ) -> list[Task]:
     """One ``build`` task per selected package, and one ``idl`` task before it for a package with
     protobuf sources. Whether a task is up to date is checked when it is dispatched (what it waits for
     done by then). With a ``remote`` cache, a package that is not up to date is first looked up there
-    (the task's ``restore``), and uploaded after it is built when the cache is writable."""
+    (the task's ``restore``), and uploaded after it is built when the cache is writable. A ``compiler``
+    cache is the compiler launcher of every CMake package."""
     selected = workspace.selected
     fingerprints = Fingerprints(workspace, options)
     remote_keys = None
@@ -57,7 +59,7 @@ def plan_build(
     for package in workspace.selected_in_order():
         dependencies = workspace.dependencies.in_order(package.name)
         build = _PackageBuild(package, workspace.root, dependencies, options, jobserver, fingerprints)
-        build.remote, build.remote_keys = remote, remote_keys
+        build.remote, build.remote_keys, build.compiler = remote, remote_keys, compiler
         waits_for = {n for n in dependencies if n in selected}
         if proto_directory(build.source) is not None:
             idl = IdlGeneration(package.name, build.source, options.build_base / package.name, forced,
@@ -92,6 +94,7 @@ class _PackageBuild:
         self.remote: RemoteCache | None = None
         self.remote_keys: RemoteKeys | None = None
         self.remote_key: str | None = None
+        self.compiler: CompilerCache | None = None
 
     def check(self) -> list[str]:
         if not self.options.use_state:
@@ -118,8 +121,12 @@ class _PackageBuild:
     def run(self, context: TaskContext) -> None:
         package, options = self.package, self.options
         env = build_environment(package, self.dependencies, options)
+        cmake_args = self.cmake_args
+        if self.compiler is not None and package.build_type in ("cmake", "ament_cmake"):
+            env.update(self.compiler.environment)
+            cmake_args = [*cmake_args, *self.compiler.cmake_arguments()]
         job = PackageJob(package=package, source=self.source, build_dir=options.build_base / package.name,
-                         prefix=self.prefix, env=env, cmake_args=self.cmake_args)
+                         prefix=self.prefix, env=env, cmake_args=cmake_args)
         if self.jobserver is not None:
             job.make_flags = self.jobserver.makeflags(env.get("MAKEFLAGS", ""))
             job.pass_fds = self.jobserver.fds

@@ -48,6 +48,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     remote.add_argument("--remote-cache-timeout", type=float, metavar="SECONDS",
                         help="give up on a server that does not answer within this time, and build "
                              "locally (default: 10)")
+    remote.add_argument("--compiler-cache", choices=("ccache", "sccache", "none"),
+                        help="compile CMake packages through ccache or sccache (on the remote cache's server "
+                             "too, when one is set)")
+    remote.add_argument("--compiler-cache-dir", metavar="DIR",
+                        help="the compiler cache's local directory (default: the tool's own)")
     cmake = parser.add_argument_group("cmake and ament_cmake packages")
     cmake.add_argument("--cmake-target", help="build this target instead of the default one (no install)")
     cmake.add_argument("--cmake-target-skip-unavailable", action="store_true",
@@ -193,6 +198,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _build(args, workspace, options, switches: dict[str, bool]) -> int:
+    from roc.builder.compiler_cache import compiler_cache
     from roc.builder.layout import refresh_install_scripts
     from roc.builder.plan import plan_build
     from roc.engine.executor import execute
@@ -200,15 +206,21 @@ def _build(args, workspace, options, switches: dict[str, bool]) -> int:
     from roc.engine.store import DurationStore
 
     workers = 1 if args.executor == "sequential" else args.parallel_workers
+    compiler = None
     durations = DurationStore(options.build_base / DURATIONS_FILE)
     jobserver = Jobserver(options.jobs)
     handlers = [*output_handlers(args, switches, workspace.root, options.build_base), durations]
     try:
-        tasks = plan_build(workspace, options, jobserver, durations.durations,
-                           _remote_cache(args, workspace, options))
+        remote = _remote_cache(args, workspace, options)
+        compiler = compiler_cache(args.compiler_cache, args.compiler_cache_dir, workspace.root, options.build_base,
+                                  remote.settings if remote else None)
+        tasks = plan_build(workspace, options, jobserver, durations.durations, remote, compiler)
         result = execute(tasks, handlers, workers, continue_on_error=args.continue_on_error)
     finally:
         jobserver.close()
+        statistics = compiler.finish() if compiler is not None else None
+        if statistics and args.output != "json":
+            print(statistics, flush=True)
         for handler in handlers:  # e.g. the terminal's live line, when the run ended by an error
             getattr(handler, "close", lambda: None)()
     durations.save()
