@@ -33,6 +33,17 @@ def write_text_atomic(path: Path, text: str, mode: int | None = None) -> None:
         raise
 
 
+def write_text_if_changed(path: Path, text: str) -> None:
+    """``write_text_atomic``, skipped when the file already holds ``text`` (a no-op build then renames
+    nothing: a rename costs about a millisecond here)."""
+    try:
+        if path.read_text() == text:
+            return
+    except (OSError, UnicodeDecodeError):
+        pass
+    write_text_atomic(path, text)
+
+
 def file_sha256(path: Path) -> str:
     import hashlib
 

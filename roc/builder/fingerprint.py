@@ -40,9 +40,10 @@ def source_stamps(directory: Path, previous: FileStamps) -> FileStamps:
     """The stamps of the package's files (hidden and ignored directories and editor droppings skipped;
     symlinks followed, each real directory once)."""
     stamps: FileStamps = {}
-    seen: set[str] = set()
+    seen: set[tuple[int, int]] = set()
     for dirpath, dirnames, filenames in os.walk(directory, followlinks=True):
-        real = os.path.realpath(dirpath)
+        info = os.stat(dirpath)
+        real = (info.st_dev, info.st_ino)  # cheaper than realpath, which stats every component
         if real in seen or (any(m in filenames for m in IGNORE_MARKERS) and dirpath != str(directory)):
             dirnames.clear()
             continue

@@ -119,13 +119,16 @@ def warn_about_overrides(args: argparse.Namespace, workspace, install_base: Path
 def _remote_cache(args: argparse.Namespace, workspace, options):
     """The run's RemoteCache, or None when the remote cache is off or not configured. The environment
     wins over roc.toml; the command line over both."""
-    from roc.remote_cache.settings import URL_VARIABLE, remote_settings
+    if not (args.remote_cache or os.environ.get("ROC_REMOTE_CACHE")):
+        return None  # (nothing of the remote cache imported: a no-op build stays fast)
+    from roc.remote_cache.settings import MODE_VARIABLE, URL_VARIABLE, remote_settings
 
     config = getattr(args, "configuration", None)
-    url = args.remote_cache
-    if config is not None and config.from_configuration(args, "remote_cache") and os.environ.get(URL_VARIABLE):
-        url = None
-    settings = remote_settings(url, args.remote_cache_mode, args.remote_cache_timeout)
+    given = {}
+    for dest, variable in (("remote_cache", URL_VARIABLE), ("remote_cache_mode", MODE_VARIABLE)):
+        from_file = config is not None and config.from_configuration(args, dest)
+        given[dest] = None if from_file and os.environ.get(variable) else getattr(args, dest)
+    settings = remote_settings(given["remote_cache"], given["remote_cache_mode"], args.remote_cache_timeout)
     if settings is None:
         return None
     if settings.url.startswith("s3://"):
@@ -198,7 +201,6 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _build(args, workspace, options, switches: dict[str, bool]) -> int:
-    from roc.builder.compiler_cache import compiler_cache
     from roc.builder.layout import refresh_install_scripts
     from roc.builder.plan import plan_build
     from roc.engine.executor import execute
@@ -212,8 +214,11 @@ def _build(args, workspace, options, switches: dict[str, bool]) -> int:
     handlers = [*output_handlers(args, switches, workspace.root, options.build_base), durations]
     try:
         remote = _remote_cache(args, workspace, options)
-        compiler = compiler_cache(args.compiler_cache, args.compiler_cache_dir, workspace.root, options.build_base,
-                                  remote.settings if remote else None)
+        if args.compiler_cache not in (None, "none"):
+            from roc.builder.compiler_cache import compiler_cache
+
+            compiler = compiler_cache(args.compiler_cache, args.compiler_cache_dir, workspace.root,
+                                      options.build_base, remote.settings if remote else None)
         tasks = plan_build(workspace, options, jobserver, durations.durations, remote, compiler)
         result = execute(tasks, handlers, workers, continue_on_error=args.continue_on_error)
     finally:
@@ -224,7 +229,7 @@ def _build(args, workspace, options, switches: dict[str, bool]) -> int:
         for handler in handlers:  # e.g. the terminal's live line, when the run ended by an error
             getattr(handler, "close", lambda: None)()
     durations.save()
-    refresh_install_scripts(options.install_base, args.merge_install)
+    refresh_install_scripts(options.install_base, args.merge_install, options.build_base)
     if result.interrupted:
         return EXIT_INTERRUPTED
     return 0 if result.ok else EXIT_FAILURE
