@@ -173,7 +173,10 @@ def build_parser(argv: list[str] | None = None) -> Parser:
         (): parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     }
     for path, aliases, module, help_text in COMMANDS:
-        sub = groups[path[:-1]].add_parser(path[-1], aliases=list(aliases), help=help_text, description=help_text)
+        # -h only on the way to the named command: argparse builds a help formatter for each -h it adds
+        on_the_way = wanted is None or path == wanted[:len(path)]
+        sub = groups[path[:-1]].add_parser(path[-1], aliases=list(aliases), help=help_text, description=help_text,
+                                           add_help=on_the_way)
         if module is None:
             groups[path] = sub.add_subparsers(dest="_".join(path) + "_command", metavar="COMMAND", parser_class=Parser)
             sub.set_defaults(_group=sub)
