@@ -33,15 +33,16 @@ def write_text_atomic(path: Path, text: str, mode: int | None = None) -> None:
         raise
 
 
-def write_text_if_changed(path: Path, text: str) -> None:
+def write_text_if_changed(path: Path, text: str) -> bool:
     """``write_text_atomic``, skipped when the file already holds ``text`` (a no-op build then renames
-    nothing: a rename costs about a millisecond here)."""
+    nothing: a rename costs about a millisecond here); whether it wrote."""
     try:
         if path.read_text() == text:
-            return
+            return False
     except (OSError, UnicodeDecodeError):
         pass
     write_text_atomic(path, text)
+    return True
 
 
 def file_sha256(path: Path) -> str:

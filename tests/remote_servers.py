@@ -17,6 +17,8 @@ import threading
 from collections.abc import Iterator
 from pathlib import Path
 
+from build_helpers import stop_process
+
 HERE = Path(__file__).resolve().parent
 
 
@@ -56,12 +58,7 @@ def _server(*args: str) -> Iterator[int]:
         assert line.strip().isdigit(), f"the {args[0]} server did not start"
         yield int(line)
     finally:
-        process.terminate()
-        try:
-            process.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait()
+        stop_process(process)
 
 
 def webdav(root: Path, user: str | None = None, password: str | None = None) -> contextlib.AbstractContextManager[int]:

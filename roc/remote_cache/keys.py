@@ -22,7 +22,7 @@ import sys
 from pathlib import Path
 
 from roc.builder.artefact import Places
-from roc.builder.fingerprint import REGENERATED_INSTALL_FILES, combine
+from roc.builder.fingerprint import REGENERATED_INSTALL_FILES, combine, underlay_location
 from roc.builder.state import read_state
 from roc.fsutil import file_sha256
 
@@ -57,16 +57,13 @@ def _prefix_content(prefix: str) -> str:
 def underlay_content(name: str, prefixes: tuple[str, ...]) -> str | None:
     """An underlay package by content: its package.xml in a shared prefix (/opt/ros, a venv), all of
     its files in a prefix of its own. None when no underlay has it."""
-    for prefix in prefixes:
-        share = os.path.join(prefix, "share", name)
-        if not os.path.isdir(share):
-            continue
-        if os.path.basename(os.path.normpath(prefix)) == name:
-            return f"{prefix}:files:{_prefix_content(prefix)}"
-        manifest = os.path.join(share, "package.xml")
-        if os.path.exists(manifest):
-            return f"{prefix}:package.xml:{file_sha256(Path(manifest))}"
-    return None
+    found = underlay_location(name, prefixes)
+    if found is None:
+        return None
+    prefix, manifest = found
+    if manifest is None:
+        return f"{prefix}:files:{_prefix_content(prefix)}"
+    return f"{prefix}:package.xml:{file_sha256(Path(manifest))}"
 
 
 def platform_parts() -> dict[str, object]:
