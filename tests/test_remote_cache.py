@@ -262,3 +262,26 @@ def test_s3_store(tmp_path):
         assert wrong.returncode == 0 and _started(denied) == {"app", "core", "plain", "pyp"}
         assert wrong.stderr.count("remote cache") == 1 and "roc-test-secret" not in wrong.stdout + wrong.stderr
     assert os.environ.get("AWS_SECRET_ACCESS_KEY") != "roc-test-secret"
+
+
+def test_generated_interface_package_restored_elsewhere_runs(dav, tmp_path):
+    """A package with an idl task (protobuf sources): rosidl's generated code travels, and the
+    conversion code its dependent uses runs at the new path."""
+    from test_idl_task import CONVERT
+
+    url, _, env = dav
+    ci, dev = tmp_path / "ci", tmp_path / "elsewhere" / "dev"
+    for ws in (ci, dev):
+        shutil.copytree(FIXTURES / "idl" / "src", ws / "src")
+    built = roc("work", "build", "--remote-cache", f"{url}/idl", "--remote-cache-mode", "read-write", cwd=ci,
+                env=env, timeout=900)
+    assert built.returncode == 0, built.stdout + built.stderr
+    restored = roc("work", "build", "--remote-cache", f"{url}/idl", cwd=dev, env=env)
+    assert restored.returncode == 0, restored.stdout + restored.stderr
+    reasons = [e["reasons"] for e in _events(dev) if e["event"] == "TaskStarted"]
+    assert _restored(dev) == {"robot_proto_msgs", "robot_proto_tools"}, (reasons, restored.stderr)
+    assert _started(dev) == {"robot_proto_msgs"}
+    assert {e["kind"] for e in _events(dev) if e["event"] == "TaskStarted"} == {"idl"}  # only the generation ran
+    (tmp_path / "convert.py").write_text(CONVERT)
+    ran = in_sourced_shell(dev, f"python {tmp_path / 'convert.py'}")
+    assert ran.returncode == 0 and ran.stdout.strip() == "x y theta", ran.stdout + ran.stderr

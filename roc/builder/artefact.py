@@ -30,8 +30,8 @@ STATE_FILES = (STATE_FILE, "colcon_build.rc", "cmake_args.last", "install_manife
 # The files an install wrote, as the build tools list them (absolute paths), for the merged layout.
 INSTALL_RECORDS = ("install_manifest.txt", "install.log")
 # Files in which an old path is rewritten instead of ruling the package out: their meaning is known.
-REWRITABLE = ("install_manifest.txt", "install.log", "SOURCES.txt", "local_setup.sh", "local_setup.bash",
-              "local_setup.zsh")
+REWRITABLE = ("install_manifest.txt", "install.log", "cmake_args.last", "SOURCES.txt", "local_setup.sh",
+              "local_setup.bash", "local_setup.zsh")
 REWRITABLE_DIRS = ("parent_prefix_path",)
 # roc's own generated scripts: written again for the new place.
 REGENERATED = ("package.sh", "package.bash", "package.zsh")
@@ -59,6 +59,11 @@ class Places:
 
 def _replacements(old: Places, new: Places) -> dict[bytes, bytes]:
     return {str(a).encode(): str(b).encode() for a, b in zip(old.paths(), new.paths()) if a != b}
+
+
+def _pattern(paths: list[bytes]) -> re.Pattern[bytes]:
+    """Any of ``paths``, longest first (so a path inside another is not matched on its own)."""
+    return re.compile(b"|".join(re.escape(p) for p in sorted(paths, key=len, reverse=True)))
 
 
 def installed_files(name: str, places: Places, merged: bool) -> list[Path]:
@@ -106,21 +111,28 @@ def pack(archive: Path, name: str, places: Places, merged: bool) -> None:
         temporary.unlink(missing_ok=True)
 
 
-def path_dependent_file(files: list[Path], base: Path, paths: list[Path]) -> str | None:
-    """The first of ``files`` (below ``base``) that holds one of ``paths`` where unpacking cannot
+def path_dependent_file(files: list[Path], base: Path, places: Places) -> str | None:
+    """The first of ``files`` (below ``base``) that holds a path of ``places`` where unpacking cannot
     rewrite it (such a package can only be restored into a workspace at the same place)."""
-    pattern = re.compile(b"|".join(re.escape(str(p).encode()) for p in paths))
+    everything = _pattern([str(p).encode() for p in places.paths()])
+    installed = _pattern([str(places.install_base).encode()])
     for path in files:
         if path.is_file() and not path.is_symlink() and path.suffix != ".pyc":
-            data = path.read_bytes()
-            if pattern.search(data) and _keeps_path(path, data):
+            if _keeps_path(path, path.read_bytes(), everything, installed):
                 return str(path.relative_to(base))
     return None
 
 
-def _keeps_path(path: Path, data: bytes) -> bool:
-    """Whether an old path in this file stays after unpacking (it is neither regenerated nor rewritten)."""
+def _keeps_path(path: Path, data: bytes, everything: re.Pattern[bytes], installed: re.Pattern[bytes]) -> bool:
+    """Whether a path that matters stays in this file after unpacking. In a compiled binary (ELF)
+    only the install path matters: source and build paths there are debug information and assert
+    messages (``__FILE__``), which name where it was built, as in any binary package. Elsewhere every
+    path matters, unless the file is regenerated or a text file of known meaning (rewritten)."""
     if _regenerated(path):
+        return False
+    if data[:4] == b"\x7fELF":
+        return installed.search(data) is not None
+    if everything.search(data) is None:
         return False
     return not (_is_text(data) and (path.name in REWRITABLE or path.parent.name in REWRITABLE_DIRS))
 
@@ -134,22 +146,24 @@ def _is_text(data: bytes) -> bool:
     return b"\0" not in data[:8192]
 
 
-def _relocate(tree: Path, replacements: dict[bytes, bytes]) -> str | None:
+def _relocate(tree: Path, built_at: Places, places: Places) -> str | None:
     """Rewrite the old paths in known text files of ``tree``; the first other file that still holds
-    an old path (None when there is none)."""
-    # One pass, longest old path first, so that a new path containing an old one is not rewritten again.
-    pattern = re.compile(b"|".join(re.escape(old) for old in sorted(replacements, key=len, reverse=True)))
+    an old path that matters (None when there is none)."""
+    replacements = _replacements(built_at, places)
+    if not replacements:
+        return None
+    everything = _pattern(list(replacements))
+    installed = _pattern([str(built_at.install_base).encode()])
     for path in sorted(p for p in tree.rglob("*") if p.is_file() and not p.is_symlink()):
         if path.suffix == ".pyc":
             path.unlink()  # byte-code caches name their sources; Python writes them again
             continue
         data = path.read_bytes()
-        if not pattern.search(data):
-            continue
-        if _keeps_path(path, data):
+        if _keeps_path(path, data, everything, installed):
             return str(path.relative_to(tree))
-        if not _regenerated(path):
-            path.write_bytes(pattern.sub(lambda match: replacements[match.group(0)], data))
+        if not _regenerated(path) and _is_text(data) and everything.search(data):
+            # One pass, longest old path first: a new path containing an old one is not rewritten again.
+            path.write_bytes(everything.sub(lambda match: replacements[match.group(0)], data))
     return None
 
 
@@ -181,8 +195,7 @@ def unpack(archive: Path, package: Package, built_at: Places, places: Places, me
                 tar.extractall(tree, filter="data")
         except (tarfile.TarError, OSError, EOFError) as error:
             return f"its archive is unreadable ({error})"
-        replacements = _replacements(built_at, places)
-        depends_on_path = _relocate(tree, replacements) if replacements else None
+        depends_on_path = _relocate(tree, built_at, places)
         if depends_on_path:
             return f"{depends_on_path} holds the absolute path it was built at"
         if not (tree / "install").is_dir():

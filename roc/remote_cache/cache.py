@@ -143,7 +143,7 @@ class RemoteCache:
         try:
             pack(archive, package.name, self.places, self.merged)
             files = installed_files(package.name, self.places, self.merged)
-            bound = path_dependent_file(files, self.places.install_base, self.places.paths())
+            bound = path_dependent_file(files, self.places.install_base, self.places)
             sha256 = file_sha256(archive)
             entry = {"format": FORMAT, "roc": __version__, "package": package.name, "key": key,
                      "sha256": sha256, "size": archive.stat().st_size, "built_at": self.places.as_dict(),

@@ -50,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"exported {len(stored)} up-to-date package(s) to {cache}")
         for name in stored:
             fixed = path_dependent_file(installed_files(name, places, merged=False), options.install_base / name,
-                                        [workspace.root, options.install_base])
+                                        places)
             if fixed:
                 print(f"  {name}: import can restore it only into {workspace.root} ({fixed} holds that path)",
                       file=sys.stderr)
