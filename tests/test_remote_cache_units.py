@@ -220,3 +220,26 @@ def test_compiler_cache_settings(tmp_path, monkeypatch) -> None:
     monkeypatch.setenv("PATH", str(tmp_path / "nothing"))
     with pytest.raises(UsageError, match="'sccache' is not on PATH; install it"):
         compiler_cache("sccache", None, root, root / "build")
+
+
+def test_which_paths_make_a_package_depend_on_its_place(tmp_path) -> None:
+    from roc.builder.artefact import path_dependent_file
+
+    places = Places(tmp_path, tmp_path / "build", tmp_path / "install")
+    lib = places.install_base / "pkg" / "lib"
+    lib.mkdir(parents=True)
+    debug_only = lib / "libdebug.so"
+    debug_only.write_bytes(b"\x7fELF\0\0" + str(places.build_base / "pkg" / "gen.c").encode())  # __FILE__
+    archive = lib / "libstatic.a"
+    archive.write_bytes(b"!<arch>\n" + str(tmp_path / "src" / "pkg" / "a.c").encode())
+    manifest = places.install_base / "pkg" / "share" / "pkg" / "install_manifest.txt"
+    manifest.parent.mkdir(parents=True)
+    manifest.write_text(str(places.install_base / "pkg" / "lib" / "libdebug.so") + "\n")  # rewritten on unpack
+    files = [debug_only, archive, manifest]
+    assert path_dependent_file(files, places.install_base, places) is None
+    rpath = lib / "librpath.so"
+    rpath.write_bytes(b"\x7fELF\0\0" + str(lib).encode())  # the install path in a binary: it matters
+    assert path_dependent_file([*files, rpath], places.install_base, places) == "pkg/lib/librpath.so"
+    config = places.install_base / "pkg" / "share" / "pkg" / "where.txt"
+    config.write_text(f"sources at {tmp_path / 'src'}\n")  # any path in another text file matters
+    assert path_dependent_file([*files, config], places.install_base, places) == "pkg/share/pkg/where.txt"

@@ -33,6 +33,8 @@ INSTALL_RECORDS = ("install_manifest.txt", "install.log")
 REWRITABLE = ("install_manifest.txt", "install.log", "cmake_args.last", "SOURCES.txt", "local_setup.sh",
               "local_setup.bash", "local_setup.zsh")
 REWRITABLE_DIRS = ("parent_prefix_path",)
+# How compiled code starts: ELF files (programs, shared libraries, objects), static libraries.
+COMPILED = (b"\x7fELF", b"!<arch>\n")
 # roc's own generated scripts: written again for the new place.
 REGENERATED = ("package.sh", "package.bash", "package.zsh")
 
@@ -124,13 +126,13 @@ def path_dependent_file(files: list[Path], base: Path, places: Places) -> str | 
 
 
 def _keeps_path(path: Path, data: bytes, everything: re.Pattern[bytes], installed: re.Pattern[bytes]) -> bool:
-    """Whether a path that matters stays in this file after unpacking. In a compiled binary (ELF)
-    only the install path matters: source and build paths there are debug information and assert
+    """Whether a path that matters stays in this file after unpacking. In compiled code (ELF files,
+    static libraries) only the install path matters: source and build paths there are debug information and assert
     messages (``__FILE__``), which name where it was built, as in any binary package. Elsewhere every
     path matters, unless the file is regenerated or a text file of known meaning (rewritten)."""
     if _regenerated(path):
         return False
-    if data[:4] == b"\x7fELF":
+    if data.startswith(COMPILED):
         return installed.search(data) is not None
     if everything.search(data) is None:
         return False
