@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 import json
 import os
+import sys
 import tarfile
 from pathlib import Path
 
@@ -243,3 +244,20 @@ def test_which_paths_make_a_package_depend_on_its_place(tmp_path) -> None:
     config = places.install_base / "pkg" / "share" / "pkg" / "where.txt"
     config.write_text(f"sources at {tmp_path / 'src'}\n")  # any path in another text file matters
     assert path_dependent_file([*files, config], places.install_base, places) == "pkg/share/pkg/where.txt"
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (["--remote-cache", "ftp://cache/x"], "--remote-cache: 'ftp://cache/x' is not an http://, https:// or s3://BUCKET"),
+    (["--remote-cache", "http://u:secret@cache/x", "--remote-cache-timeout", "0"], "more than 0 seconds"),
+    (["--compiler-cache", "ccache"], "--compiler-cache ccache: 'ccache' is not on PATH; install it"),
+])
+def test_bad_settings_are_usage_errors_before_anything_is_written(tmp_path, arguments, message) -> None:
+    from build_helpers import roc, ros_env
+
+    (tmp_path / "src" / "pkg").mkdir(parents=True)
+    (tmp_path / "src" / "pkg" / "CMakeLists.txt").write_text("cmake_minimum_required(VERSION 3.14)\nproject(pkg)\n")
+    env = ros_env(PATH=f"{Path(sys.executable).parent}:/usr/bin:/bin")
+    result = roc("work", "build", *arguments, cwd=tmp_path, env=env)
+    assert result.returncode == 2 and result.stderr.startswith("roc: error: ") and message in result.stderr
+    assert "secret" not in result.stderr and "Traceback" not in result.stderr
+    assert not (tmp_path / "build").exists() and not (tmp_path / "install").exists()

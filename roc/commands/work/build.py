@@ -144,12 +144,12 @@ def _remote_cache(args: argparse.Namespace, workspace, options):
                        options.merge_install)
 
 
-def _explain(args: argparse.Namespace, workspace, options) -> int:
+def _explain(args: argparse.Namespace, workspace, options, remote) -> int:
     from roc.builder.uptodate import explain
     from roc.engine.events import task_key
     from roc.render import print_json, print_lines
 
-    explained = explain(workspace, options, _remote_cache(args, workspace, options))
+    explained = explain(workspace, options, remote)
     if args.output == "json":
         print_json([{"package": name, "kind": kind, "reasons": reasons} for kind, name, reasons in explained])
     else:
@@ -191,16 +191,23 @@ def run(args: argparse.Namespace) -> int:
         force=args.force,
         use_state=not args.no_cache,
     )
+    remote = _remote_cache(args, workspace, options)  # bad settings: a usage error before anything is written
     if args.explain:
-        return _explain(args, workspace, options)
+        return _explain(args, workspace, options, remote)
+    compiler = None
+    if args.compiler_cache not in (None, "none"):
+        from roc.builder.compiler_cache import compiler_cache
+
+        compiler = compiler_cache(args.compiler_cache, args.compiler_cache_dir, workspace.root, options.build_base,
+                                  remote.settings if remote else None)
     warn_about_overrides(args, workspace, options.install_base)
     with build_lock(options.build_base):
         prepare_build_base(options.build_base)
         prepare_install_base(options.install_base, args.merge_install)
-        return _build(args, workspace, options, switches)
+        return _build(args, workspace, options, switches, remote, compiler)
 
 
-def _build(args, workspace, options, switches: dict[str, bool]) -> int:
+def _build(args, workspace, options, switches: dict[str, bool], remote, compiler) -> int:
     from roc.builder.layout import refresh_install_scripts
     from roc.builder.plan import plan_build
     from roc.engine.executor import execute
@@ -208,17 +215,10 @@ def _build(args, workspace, options, switches: dict[str, bool]) -> int:
     from roc.engine.store import DurationStore
 
     workers = 1 if args.executor == "sequential" else args.parallel_workers
-    compiler = None
     durations = DurationStore(options.build_base / DURATIONS_FILE)
     jobserver = Jobserver(options.jobs)
     handlers = [*output_handlers(args, switches, workspace.root, options.build_base), durations]
     try:
-        remote = _remote_cache(args, workspace, options)
-        if args.compiler_cache not in (None, "none"):
-            from roc.builder.compiler_cache import compiler_cache
-
-            compiler = compiler_cache(args.compiler_cache, args.compiler_cache_dir, workspace.root,
-                                      options.build_base, remote.settings if remote else None)
         tasks = plan_build(workspace, options, jobserver, durations.durations, remote, compiler)
         result = execute(tasks, handlers, workers, continue_on_error=args.continue_on_error)
     finally:
