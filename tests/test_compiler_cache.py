@@ -48,6 +48,8 @@ def test_second_checkout_compiles_from_the_local_compiler_cache(tmp_path):
     assert _compiles(built) == (COMPILED, COMPILED)
     ran = in_sourced_shell(second, "install/app/lib/app/app; plain")
     assert ran.returncode == 0 and "core says 42" in ran.stdout
+    noop = roc("work", "build", "--compiler-cache", "sccache", "--compiler-cache-dir", directory, cwd=second, env=env)
+    assert noop.returncode == 0 and "sccache" not in noop.stdout  # nothing compiled: no server, no line
     # switched off: configured afresh, without the launcher
     off = roc("work", "build", "--force", cwd=second, env=env)
     assert off.returncode == 0

@@ -48,18 +48,32 @@ class CompilerCache:
         if "SCCACHE_SERVER_UDS" not in self.environment:
             return None
         env = {**os.environ, **self.environment}
-        if not os.path.exists(self.environment["SCCACHE_SERVER_UDS"]):
-            return None
+        if not _listening(self.environment["SCCACHE_SERVER_UDS"]):
+            return None  # nothing was compiled (asking for statistics would start a server)
         shown = _run([self.program, "--show-stats", "--stats-format", "json"], env)
         _run([self.program, "--stop-server"], env)
+        Path(self.environment["SCCACHE_SERVER_UDS"]).unlink(missing_ok=True)
         try:
             stats = json.loads(shown)["stats"]
             hits = sum(stats["cache_hits"]["counts"].values())
             misses = sum(stats["cache_misses"]["counts"].values())
         except (ValueError, KeyError, TypeError, AttributeError):
             return None
-        rate = f" ({100 * hits / (hits + misses):.0f} %)" if hits + misses else ""
-        return f"sccache: {hits} of {hits + misses} compiles from the cache{rate}"
+        if not hits + misses:
+            return None
+        return f"sccache: {hits} of {hits + misses} compiles from the cache ({100 * hits / (hits + misses):.0f} %)"
+
+
+def _listening(path: str) -> bool:
+    """Whether a server answers on the Unix socket ``path`` (a stale socket file does not)."""
+    import socket
+
+    with socket.socket(socket.AF_UNIX) as probe:
+        try:
+            probe.connect(path)
+        except OSError:
+            return False
+    return True
 
 
 def _run(command: list[str], env: dict[str, str]) -> str:
