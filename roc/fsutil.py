@@ -19,13 +19,22 @@ UMASK = _umask()
 def write_text_atomic(path: Path, text: str, mode: int | None = None) -> None:
     """Write ``text`` to ``path`` through a temporary file and a rename (never half-written), with the
     permissions a plain write would give (mkstemp makes private files)."""
+    _write_atomic(path, text, "w", mode)
+
+
+def write_bytes_atomic(path: Path, data: bytes) -> None:
+    """``write_text_atomic`` for bytes."""
+    _write_atomic(path, data, "wb", None)
+
+
+def _write_atomic(path: Path, data: str | bytes, open_mode: str, mode: int | None) -> None:
     import tempfile  # not at module level: start-up stays light for read-only commands
 
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
-        with os.fdopen(fd, "w") as handle:
-            handle.write(text)
+        with os.fdopen(fd, open_mode) as handle:
+            handle.write(data)
         os.chmod(temporary, mode if mode is not None else 0o666 & ~UMASK)
         os.replace(temporary, path)
     except BaseException:
