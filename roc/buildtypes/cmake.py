@@ -18,8 +18,8 @@ from roc.buildtypes.context import BuildOptions, PackageJob
 from roc.engine.process import TaskContext, TaskError
 from roc.fsutil import write_text_atomic
 
-TOOLS_FILE = "roc_cmake_tools.last"
-LAUNCHER = "_COMPILER_LAUNCHER="  # in the arguments --compiler-cache adds  # the programs of the last configure (see _configure_tools)
+TOOLS_FILE = "roc_cmake_tools.last"  # the programs of the last configure (see _configure_tools)
+LAUNCHER = "_COMPILER_LAUNCHER="  # in the arguments --compiler-cache adds
 
 
 def cmake_arguments(job: PackageJob, options: BuildOptions) -> list[str]:
