@@ -19,18 +19,39 @@ UMASK = _umask()
 def write_text_atomic(path: Path, text: str, mode: int | None = None) -> None:
     """Write ``text`` to ``path`` through a temporary file and a rename (never half-written), with the
     permissions a plain write would give (mkstemp makes private files)."""
+    _write_atomic(path, text, "w", mode)
+
+
+def write_bytes_atomic(path: Path, data: bytes) -> None:
+    """``write_text_atomic`` for bytes."""
+    _write_atomic(path, data, "wb", None)
+
+
+def _write_atomic(path: Path, data: str | bytes, open_mode: str, mode: int | None) -> None:
     import tempfile  # not at module level: start-up stays light for read-only commands
 
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
-        with os.fdopen(fd, "w") as handle:
-            handle.write(text)
+        with os.fdopen(fd, open_mode) as handle:
+            handle.write(data)
         os.chmod(temporary, mode if mode is not None else 0o666 & ~UMASK)
         os.replace(temporary, path)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
         raise
+
+
+def write_text_if_changed(path: Path, text: str) -> bool:
+    """``write_text_atomic``, skipped when the file already holds ``text`` (a no-op build then renames
+    nothing: a rename costs about a millisecond here); whether it wrote."""
+    try:
+        if path.read_text() == text:
+            return False
+    except (OSError, UnicodeDecodeError):
+        pass
+    write_text_atomic(path, text)
+    return True
 
 
 def file_sha256(path: Path) -> str:

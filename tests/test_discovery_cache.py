@@ -43,7 +43,7 @@ def _touch_later(path) -> None:
 
 def test_cache_is_written_and_used(ws):
     assert _list(ws) == ["a", "b"]
-    cache_files = list((ws.parent / "cache").glob("discovery-*.json"))
+    cache_files = list((ws.parent / "cache").glob("discovery-*.marshal"))
     assert len(cache_files) == 1
     assert _list(ws) == ["a", "b"]
 
@@ -93,8 +93,8 @@ def test_plain_cmake_dependencies_from_a_new_cmake_file(ws):
 
 def test_damaged_cache_is_ignored(ws):
     assert _list(ws) == ["a", "b"]
-    for cache_file in (ws.parent / "cache").glob("discovery-*.json"):
-        cache_file.write_text("{ not json")
+    for cache_file in (ws.parent / "cache").glob("discovery-*.marshal"):
+        cache_file.write_bytes(b"{ not marshal data")
     assert _list(ws) == ["a", "b"]
 
 

@@ -63,14 +63,47 @@ def installed_in_order(install_base: Path, merged: bool) -> list[str]:
     return layered_order(run_dependencies, one_at_a_time=True)
 
 
-def refresh_install_scripts(install_base: Path, merged: bool) -> None:
+SCRIPTS_STAMP = "roc_install_scripts.json"  # in the build base: what the install-level scripts were made from
+
+
+def refresh_install_scripts(install_base: Path, merged: bool, build_base: Path | None = None) -> None:
     """The install-level setup scripts for every package now in the base, chained to the underlays
-    the build used (roc.environment.chain)."""
+    the build used (roc.environment.chain). With a ``build_base``, scripts made from the same inputs
+    (packages, layout, underlays, templates) and not touched since are left as they are: a no-op build
+    renders nothing (and does not import Jinja)."""
+    import hashlib
+    import json
     import os
 
     from roc.environment import with_implicit_underlay
     from roc.environment.chain import chained_underlays
-    from roc.shell.scripts import write_install_scripts
 
     underlays = chained_underlays(with_implicit_underlay(os.environ), install_base)
-    write_install_scripts(install_base, installed_in_order(install_base, merged), merged, underlays)
+    packages = installed_in_order(install_base, merged)
+    stamp = build_base / SCRIPTS_STAMP if build_base else None
+    inputs = {"packages": packages, "merged": merged, "templates": _templates_stamp(),
+              "underlays": [[u.prefix, hashlib.sha256(repr(u.operations).encode()).hexdigest()] for u in underlays]}
+    if stamp is not None and stamp.is_file() and json.loads(stamp.read_text() or "{}") == {
+            **inputs, "written": _scripts_stamp(install_base)}:
+        return
+    from roc.shell.scripts import write_install_scripts
+
+    write_install_scripts(install_base, packages, merged, underlays)
+    if stamp is not None:
+        write_text_atomic(stamp, json.dumps({**inputs, "written": _scripts_stamp(install_base)}))
+
+
+def _templates_stamp() -> list:
+    import roc.shell
+
+    folder = Path(roc.shell.__file__).parent / "templates"
+    return sorted([p.name, p.stat().st_mtime_ns] for p in folder.iterdir())
+
+
+def _scripts_stamp(install_base: Path) -> list:
+    """When each install-level script was last written (None: missing)."""
+    stamps = []
+    for name in ("local_setup.sh", "local_setup.bash", "setup.sh", "setup.bash", "setup.zsh", "setup.ps1"):
+        path = install_base / name
+        stamps.append([name, path.stat().st_mtime_ns if path.exists() else None])
+    return stamps

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from roc.builder.environment import ENVIRONMENT_FILE, build_environment
 from roc.builder.finish import finish_package
@@ -31,20 +32,34 @@ from roc.idl.task import cmake_arguments as idl_cmake_arguments
 from roc.workspace.load import Workspace
 from roc.workspace.package import Package
 
+if TYPE_CHECKING:
+    from roc.builder.compiler_cache import CompilerCache
+    from roc.remote_cache.cache import RemoteCache
+    from roc.remote_cache.keys import RemoteKeys
+
 
 def plan_build(
-    workspace: Workspace, options: BuildOptions, jobserver: Jobserver | None, weights: dict[str, float]
+    workspace: Workspace, options: BuildOptions, jobserver: Jobserver | None, weights: dict[str, float],
+    remote: RemoteCache | None = None, compiler: CompilerCache | None = None,
 ) -> list[Task]:
     """One ``build`` task per selected package, and one ``idl`` task before it for a package with
     protobuf sources. Whether a task is up to date is checked when it is dispatched (what it waits for
-    done by then)."""
+    done by then). With a ``remote`` cache, a package that is not up to date is first looked up there
+    (the task's ``restore``), and uploaded after it is built when the cache is writable. A ``compiler``
+    cache is the compiler launcher of every CMake package."""
     selected = workspace.selected
     fingerprints = Fingerprints(workspace, options)
+    remote_keys = None
+    if remote is not None:
+        from roc.remote_cache.keys import RemoteKeys
+
+        remote_keys = RemoteKeys(fingerprints.environment, fingerprints.prefixes, options.build_base)
     forced = generation_forced(options)
     tasks = []
     for package in workspace.selected_in_order():
         dependencies = workspace.dependencies.in_order(package.name)
         build = _PackageBuild(package, workspace.root, dependencies, options, jobserver, fingerprints)
+        build.remote, build.remote_keys, build.compiler = remote, remote_keys, compiler
         waits_for = {n for n in dependencies if n in selected}
         if proto_directory(build.source) is not None:
             idl = IdlGeneration(package.name, build.source, options.build_base / package.name, forced,
@@ -60,6 +75,7 @@ def plan_build(
             action=build.run,
             weight=weights.get(package.name, 1.0),
             check=build.check,
+            restore=build.restore if remote is not None else None,
         ))
     return tasks
 
@@ -75,18 +91,42 @@ class _PackageBuild:
         self.jobserver, self.fingerprints = jobserver, fingerprints
         self.state: PackageState | None = None
         self.cmake_args: list[str] = []  # roc's own CMake arguments (where the package's idl task writes)
+        self.remote: RemoteCache | None = None
+        self.remote_keys: RemoteKeys | None = None
+        self.remote_key: str | None = None
+        self.compiler: CompilerCache | None = None
 
     def check(self) -> list[str]:
         if not self.options.use_state:
             return forced_reasons(self.options)
         self.state = self.fingerprints.compute(self.package)
+        if self.remote_keys is not None:  # also for an up-to-date package: its dependents need its key
+            self.remote_key = self.remote_keys.key(self.package.name, self.state.parts)
         return stale_reasons(self.package, self.state, self.options)
+
+    def restore(self, context: TaskContext) -> str | None:
+        """Restore the package from the remote cache: None when done, else why not."""
+        if self.remote is None or self.state is None or forced_reasons(self.options):
+            return ""
+        if self.remote_key is None:
+            missing = self.remote_keys.missing_dependency(self.state.parts) if self.remote_keys else None
+            return f"no remote cache key (dependency '{missing}' has none: build it with the remote cache on)"
+        build_dir = self.options.build_base / self.package.name
+        write_state(build_dir, None, self.state.files)  # until restored whole
+        missed = self.remote.restore(self.package, self.remote_key, context)
+        if missed is None:
+            write_state(build_dir, self.state.fingerprint, self.state.files, self.state.parts, self.remote_key)
+        return missed
 
     def run(self, context: TaskContext) -> None:
         package, options = self.package, self.options
         env = build_environment(package, self.dependencies, options)
+        cmake_args = self.cmake_args
+        if self.compiler is not None and package.build_type in ("cmake", "ament_cmake"):
+            env.update(self.compiler.environment)
+            cmake_args = [*cmake_args, *self.compiler.cmake_arguments()]
         job = PackageJob(package=package, source=self.source, build_dir=options.build_base / package.name,
-                         prefix=self.prefix, env=env, cmake_args=self.cmake_args)
+                         prefix=self.prefix, env=env, cmake_args=cmake_args)
         if self.jobserver is not None:
             job.make_flags = self.jobserver.makeflags(env.get("MAKEFLAGS", ""))
             job.pass_fds = self.jobserver.fds
@@ -99,4 +139,6 @@ class _PackageBuild:
         build_function(package.type)(context, job, options)
         finish_package(package, job.prefix)
         if self.state is not None and not options.partial():
-            write_state(job.build_dir, self.state.fingerprint, files, self.state.parts)
+            write_state(job.build_dir, self.state.fingerprint, files, self.state.parts, self.remote_key)
+            if self.remote is not None and self.remote.settings.writes and self.remote_key:
+                self.remote.upload(package, self.remote_key, context)

@@ -6,6 +6,7 @@ file is reported and ignored (the package is rebuilt), never trusted."""
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 from roc.fsutil import write_text_atomic
@@ -33,9 +34,13 @@ def read_state(build_dir: Path) -> dict:
     return read_record(build_dir / STATE_FILE, "damaged build state; the package will be rebuilt")
 
 
-def write_state(build_dir: Path, fingerprint: str | None, files: dict, parts: dict | None = None) -> None:
-    """Record ``fingerprint`` (made of ``parts``) as built; None: not up to date (a build started)."""
+def write_state(build_dir: Path, fingerprint: str | None, files: dict, parts: dict | None = None,
+                remote_key: str | None = None) -> None:
+    """Record ``fingerprint`` (made of ``parts``) as built; None: not up to date (a build started).
+    ``remote_key``: the package's remote cache key (roc.remote_cache.keys), when it has one."""
     state = {"fingerprint": fingerprint, "files": files, "parts": parts}
+    if remote_key:
+        state["remote_key"] = remote_key
     write_text_atomic(build_dir / STATE_FILE, json.dumps(state, separators=(",", ":")))
 
 
@@ -46,9 +51,11 @@ def install_intact(prefix: Path, name: str, build_dir: Path) -> bool:
     if not (prefix / "share" / name / "package.dsv").is_file():
         return False
     for manifest in ("install_manifest.txt", "install.log"):
-        path = build_dir / manifest
-        if path.is_file():
-            for line in path.read_text().splitlines():
-                if line and not line.endswith(".pyc") and not Path(line).exists() and not Path(line).is_symlink():
-                    return False
+        try:
+            lines = (build_dir / manifest).read_text().splitlines()
+        except (FileNotFoundError, NotADirectoryError):
+            continue
+        for line in lines:  # os.path, not pathlib: this runs for every installed file on a no-op build
+            if line and not line.endswith(".pyc") and not os.path.lexists(line):
+                return False
     return True

@@ -59,7 +59,7 @@ class Fingerprints:
     def __init__(self, workspace: Workspace, options: BuildOptions):
         self.workspace, self.options = workspace, options
         self.environment = base_environment()
-        self._prefixes = underlay_prefixes(self.environment, options.install_base)
+        self.prefixes = underlay_prefixes(self.environment, options.install_base)
         self._external: dict[str, str | None] = {}
         self._now: dict[str, str] = {}
 
@@ -70,7 +70,7 @@ class Fingerprints:
 
     def _underlay(self, name: str) -> str | None:
         if name not in self._external:
-            self._external[name] = external_stamp(name, self._prefixes)
+            self._external[name] = external_stamp(name, self.prefixes)
         return self._external[name]
 
     def compute(self, package: Package) -> PackageState:
@@ -128,20 +128,35 @@ def generation_forced(options: BuildOptions) -> list[str]:
     return [flag for flag in forced_reasons(options) if flag in ("--no-cache", "--force")]
 
 
-def explain(workspace: Workspace, options: BuildOptions) -> list[tuple[str, str, list[str]]]:
+def explain(workspace: Workspace, options: BuildOptions, remote=None) -> list[tuple[str, str, list[str]]]:
     """Each task of the build, in build order, as (kind, package, why it would run; empty: up to date):
-    a package's ``idl`` task (protobuf sources) before its ``build`` task."""
+    a package's ``idl`` task (protobuf sources) before its ``build`` task. With a ``remote`` cache
+    (roc.remote_cache.cache.RemoteCache), a package that would be built also says whether the cache
+    has it."""
     from roc.idl.task import proto_directory
     from roc.idl.task import stale_reasons as generation_reasons
 
     fingerprints = Fingerprints(workspace, options)
+    remote_keys = None
+    if remote is not None:
+        from roc.remote_cache.keys import RemoteKeys
+
+        remote_keys = RemoteKeys(fingerprints.environment, fingerprints.prefixes, options.build_base)
     explained = []
     for package in workspace.selected_in_order():
         source = (workspace.root / package.path).resolve()
         if proto_directory(source) is not None:
             explained.append(("idl", package.name, generation_reasons(source, options.build_base / package.name,
                                                                       generation_forced(options))))
-        explained.append(("build", package.name, stale_reasons(package, fingerprints.compute(package), options)))
+        state = fingerprints.compute(package)
+        reasons = stale_reasons(package, state, options)
+        if remote_keys is not None:
+            key = remote_keys.key(package.name, state.parts)
+            if reasons and not forced_reasons(options):
+                reasons.append(remote.has(key) if key else
+                               f"no remote cache key (dependency '{remote_keys.missing_dependency(state.parts)}' "
+                               "has none)")
+        explained.append(("build", package.name, reasons))
     return explained
 
 

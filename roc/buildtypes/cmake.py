@@ -19,6 +19,7 @@ from roc.engine.process import TaskContext, TaskError
 from roc.fsutil import write_text_atomic
 
 TOOLS_FILE = "roc_cmake_tools.last"  # the programs of the last configure (see _configure_tools)
+LAUNCHER = "_COMPILER_LAUNCHER="  # in the arguments --compiler-cache adds
 
 
 def cmake_arguments(job: PackageJob, options: BuildOptions) -> list[str]:
@@ -112,8 +113,10 @@ def build_cmake(context: TaskContext, job: PackageJob, options: BuildOptions) ->
     recorded = repr(args) if args else "None"
     tools = _configure_tools(job, args)
     last_tools = build_dir / TOOLS_FILE
-    if options.cmake_clean_cache or (last_tools.exists() and last_tools.read_text() != tools):
-        # A cache keeps the compilers and build program of its first configure: start a new one.
+    launcher_dropped = last_args.exists() and LAUNCHER in last_args.read_text() and LAUNCHER not in recorded
+    if options.cmake_clean_cache or launcher_dropped or (last_tools.exists() and last_tools.read_text() != tools):
+        # A cache keeps the compilers and build program of its first configure, and a compiler launcher
+        # (--compiler-cache) once set: start a new one.
         (build_dir / "CMakeCache.txt").unlink(missing_ok=True)
         shutil.rmtree(build_dir / "CMakeFiles", ignore_errors=True)
     if job.package.build_type == "ament_cmake":

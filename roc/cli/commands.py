@@ -177,8 +177,8 @@ def requested_command(argv: list[str]) -> tuple[str, ...]:
 
 
 def build_parser(argv: list[str] | None = None) -> Parser:
-    """The argument parser; with ``argv`` only the named command's options are set up (every command
-    is still listed), which keeps start-up short."""
+    """The argument parser; with ``argv`` naming a command, only the parsers on the way to it are made
+    (otherwise every command is listed, for help and errors), which keeps start-up short."""
     wanted = requested_command(argv) if argv is not None else None
     parser = Parser(prog="roc", description="roc: fast, dependable tools for ROS 2 workspaces.")
     parser.add_argument("--version", action="version", version=f"roc {__version__}")
@@ -188,10 +188,16 @@ def build_parser(argv: list[str] | None = None) -> Parser:
     groups: dict[tuple[str, ...], argparse._SubParsersAction] = {
         (): parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     }
+    leaf_named = wanted is not None and any(path == wanted and module for path, _, module, _ in COMMANDS)
     for path, aliases, module, help_text in COMMANDS:
+        # -h only on the way to the named command: argparse builds a help formatter for each -h it adds
+        on_the_way = wanted is None or path == wanted[:len(path)]
+        if leaf_named and not on_the_way:
+            continue  # a command is named: the parsers of the others are never used
         if module is None:
             help_text = f"{help_text}: {', '.join(verbs(path))}"
-        sub = groups[path[:-1]].add_parser(path[-1], aliases=list(aliases), help=help_text, description=help_text)
+        sub = groups[path[:-1]].add_parser(path[-1], aliases=list(aliases), help=help_text, description=help_text,
+                                           add_help=on_the_way)
         if module is None:
             groups[path] = sub.add_subparsers(dest="_".join(path) + "_command", metavar="COMMAND", parser_class=Parser)
             sub.set_defaults(_group=sub)

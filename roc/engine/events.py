@@ -32,6 +32,12 @@ class TaskQueued(Event):
 
 
 @dataclass(frozen=True)
+class TaskRestoring(Event):
+    """A worker looks for the task's result in a cache (a remote build cache) before running it; a
+    TaskFinished with ``restored`` or a TaskStarted (a miss, its reason among the reasons) follows."""
+
+
+@dataclass(frozen=True)
 class TaskStarted(Event):
     reasons: tuple[str, ...] = ()  # why it is not up to date (empty when it has no up-to-date check)
 
@@ -58,6 +64,15 @@ class TaskOutput(Event):
 class TaskFinished(Event):
     duration: float = 0.0
     cached: bool = False  # skipped because it was up to date
+    restored: bool = False  # not run: its result was fetched from a cache (after a TaskRestoring)
+
+
+@dataclass(frozen=True)
+class TaskWarning(Event):
+    """Something about a task the user should know that does not fail it (a remote cache that is down,
+    a damaged cache entry)."""
+
+    message: str = ""
 
 
 @dataclass(frozen=True)

@@ -21,6 +21,7 @@ from roc.engine.events import (
     TaskFailed,
     TaskFinished,
     TaskQueued,
+    TaskRestoring,
     TaskSkipped,
     TaskStarted,
     Tick,
@@ -48,6 +49,17 @@ class RunResult:
 
 
 def _work(task: Task, context: TaskContext, reasons: tuple[str, ...]) -> None:
+    start = time.monotonic()
+    if task.restore is not None and not context.cancelled:
+        context.emit(TaskRestoring(task.name, task.kind))
+        try:
+            missed = task.restore(context)
+        except Exception as error:  # noqa: BLE001 - a cache that breaks is a miss: the task runs
+            missed = f"restore failed: {type(error).__name__}: {error}"
+        if missed is None:
+            context.emit(TaskFinished(task.name, task.kind, duration=time.monotonic() - start, restored=True))
+            return
+        reasons = (*reasons, missed) if missed else reasons
     context.emit(TaskStarted(task.name, task.kind, reasons=reasons))
     start = time.monotonic()
     try:

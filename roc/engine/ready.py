@@ -6,6 +6,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
 from roc.engine.events import task_key
+from roc.engine.process import TaskContext
 
 
 @dataclass
@@ -15,6 +16,10 @@ class Task:
     ``check``, when given, runs when the task is about to be dispatched (after its dependencies have
     finished, so it sees what they produced) and returns the reasons the task must run; an empty list
     finishes the task as cached without taking a worker.
+
+    ``restore``, when given, runs in the worker before the action: it fetches the task's result from a
+    cache and returns None when it did (the action does not run), else why not ("" for no reason worth
+    telling), added to the reasons of the task's start.
     """
 
     name: str  # what the task works on (a package, a probe)
@@ -23,6 +28,7 @@ class Task:
     kind: str = "build"  # build, idl, test, probe, ...
     weight: float = 1.0  # expected duration (seconds, or 1.0 when unknown)
     check: Callable[[], list[str]] | None = None
+    restore: Callable[[TaskContext], str | None] | None = None
 
     @property
     def key(self) -> str:

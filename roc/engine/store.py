@@ -9,7 +9,7 @@ import json
 from pathlib import Path
 
 from roc.engine.events import Event, TaskFinished
-from roc.fsutil import write_text_atomic
+from roc.fsutil import write_text_if_changed
 
 
 class DurationStore:
@@ -21,8 +21,8 @@ class DurationStore:
             self.durations = {}  # missing or damaged: schedule without weights
 
     def __call__(self, event: Event) -> None:
-        if isinstance(event, TaskFinished) and not event.cached:
+        if isinstance(event, TaskFinished) and not (event.cached or event.restored):
             self.durations[event.key] = round(event.duration, 3)
 
     def save(self) -> None:
-        write_text_atomic(self.path, json.dumps(self.durations, indent=1, sort_keys=True))
+        write_text_if_changed(self.path, json.dumps(self.durations, indent=1, sort_keys=True))

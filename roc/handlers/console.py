@@ -17,6 +17,7 @@ from roc.engine.events import (
     TaskQueued,
     TaskSkipped,
     TaskStarted,
+    TaskWarning,
     TestFailures,
 )
 from roc.handlers.logs import task_log_folder
@@ -82,6 +83,7 @@ class ConsoleHandler:
         self._all: dict[str, bytearray] = {}
         self.finished: list[str] = []
         self.cached: list[str] = []
+        self.restored: list[str] = []  # fetched from the remote build cache, not run
         self.failed: list[str] = []
         self.aborted: list[str] = []
         self.skipped: dict[str, str] = {}
@@ -105,6 +107,12 @@ class ConsoleHandler:
         self.stream.write(text + "\n")
         self.stream.flush()
 
+    def _warn(self, text: str) -> None:
+        if self.status is not None:
+            self.status.print(text)
+        else:
+            print(text, file=sys.stderr, flush=True)
+
     def __call__(self, event: Event) -> None:
         if isinstance(event, TaskOutput):
             if self.direct:
@@ -125,6 +133,8 @@ class ConsoleHandler:
             self.skipped[self.label(event)] = self._labels.get(event.because_of, event.because_of)
         elif isinstance(event, TestFailures):
             self.test_failures.append(self.label(event))
+        elif isinstance(event, TaskWarning):
+            self._warn(f"roc: warning: {self.label(event)}: {event.message}")
         elif isinstance(event, RunFinished):
             if self.status is not None:
                 self.status(event)  # stops the live line, before the summary
@@ -141,7 +151,10 @@ class ConsoleHandler:
         elif self.stderr and not self.direct and key in self._stderr:
             where = f" (log: {self.log_path}/{task_log_folder(event, self.kind)}/stderr.log)" if self.log_path else ""
             self._print(f"--- stderr: {name}{where}\n{self._stderr[key].decode(errors='replace').rstrip()}\n---")
-        if isinstance(event, TaskFinished):
+        if isinstance(event, TaskFinished) and event.restored:
+            self.restored.append(name)
+            line = f"Restored <<< {name} [from cache, {format_duration(event.duration)}]"
+        elif isinstance(event, TaskFinished):
             (self.cached if event.cached else self.finished).append(name)
             line = f"Finished <<< {name} [{'cached' if event.cached else format_duration(event.duration)}]"
             if self.finished_note:
@@ -159,7 +172,10 @@ class ConsoleHandler:
 
     def _print_summary(self, event: RunFinished) -> None:
         total = format_duration(time.monotonic() - self.started_at)
-        lines = ["", f"Summary: {_count(self.finished + self.cached, self.noun)} finished [{total}]"]
+        lines = ["", f"Summary: {_count(self.finished + self.restored + self.cached, self.noun)} finished [{total}]"]
+        if self.restored:
+            lines[-1] += (f" ({len(self.finished)} built, {len(self.restored)} restored from the remote cache, "
+                          f"{len(self.cached)} up to date)")
         if self.cached:
             names = f": {_names(self.cached)}" if len(self.cached) <= 10 else ""
             lines.append(f"  {_count(self.cached, self.noun)} {self.cached_label}{names}")

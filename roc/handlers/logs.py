@@ -26,7 +26,7 @@ from roc.engine.events import (
     TestFailures,
     Tick,
 )
-from roc.fsutil import write_text_atomic
+from roc.fsutil import write_text_atomic, write_text_if_changed
 from roc.workspace.selection import INTERRUPTED_RESULT
 
 
@@ -142,7 +142,7 @@ class ResultStore:
             return
         if result == "0" and event.key in self.test_failures:
             result = TEST_FAILURES_RESULT
-        write_text_atomic(self.build_base / event.task / RESULT_FILES[kind], result + "\n")
+        write_text_if_changed(self.build_base / event.task / RESULT_FILES[kind], result + "\n")
 
 
 class JsonEventsHandler:

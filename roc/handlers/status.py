@@ -17,6 +17,7 @@ from roc.engine.events import (
     TaskFinished,
     TaskOutput,
     TaskQueued,
+    TaskRestoring,
     TaskSkipped,
     TaskStarted,
 )
@@ -69,7 +70,7 @@ class StatusLine:
     def __call__(self, event: Event) -> None:
         if isinstance(event, TaskQueued):
             self.total += 1
-        elif isinstance(event, TaskStarted):
+        elif isinstance(event, (TaskStarted, TaskRestoring)):
             self.running[event.key] = None
             self._labels[event.key] = event.task if event.kind == self.kind else event.key
         elif isinstance(event, TaskOutput) and event.key in self.running:

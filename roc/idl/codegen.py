@@ -16,7 +16,7 @@ import tempfile
 from pathlib import Path
 
 from roc.errors import RocError
-from roc.fsutil import write_text_atomic
+from roc.fsutil import write_text_if_changed
 from roc.idl import proto_to_msg, protoc
 from roc.idl.config import Config
 from roc.idl.package import package_files
@@ -69,14 +69,8 @@ def write_outputs(out: Path, files: dict[str, str]) -> list[str]:
     removed. Returns the paths written or removed."""
     touched = []
     for relative, text in sorted(files.items()):
-        path = out / relative
-        try:
-            if path.read_text() == text:
-                continue
-        except (OSError, UnicodeDecodeError):
-            pass
-        write_text_atomic(path, text)
-        touched.append(relative)
+        if write_text_if_changed(out / relative, text):
+            touched.append(relative)
     if out.is_dir():
         for path in sorted(out.rglob("*"), reverse=True):  # files before their directories
             relative = str(path.relative_to(out))

@@ -20,7 +20,6 @@ import hashlib
 import json
 import os
 import sys
-from importlib import metadata
 from pathlib import Path
 
 from roc.builder.environment import base_environment
@@ -60,6 +59,8 @@ def cmake_arguments(build_dir: Path) -> list[str]:
 @functools.cache
 def generator_stamp() -> str:
     """The code generator's identity: roc's IDL modules and protoc (a new roc or protoc generates anew)."""
+    from importlib import metadata  # slow to import: only when a workspace has protobuf sources
+
     digest = hashlib.sha256()
     for path in sorted(Path(__file__).parent.glob("*.py")):
         digest.update(path.name.encode() + b"\0" + path.read_bytes())

@@ -37,6 +37,22 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="build nothing: print each selected package, in build order, and why it would be built")
     add("--no-cache", action="store_true",
         help="neither skip up-to-date packages nor record fingerprints for the next build")
+    remote = parser.add_argument_group("remote build cache (docs/caching.md)")
+    remote.add_argument("--remote-cache", metavar="URL",
+                        help="restore packages built elsewhere from this cache (http(s):// WebDAV or "
+                             "bazel-remote, s3://BUCKET/PREFIX) instead of building them (default: "
+                             "$ROC_REMOTE_CACHE)")
+    remote.add_argument("--remote-cache-mode", choices=("read", "read-write", "off"),
+                        help="read: restore only (default); read-write: also upload what is built (CI); "
+                             "off: do not use it (default: $ROC_REMOTE_CACHE_MODE, else read)")
+    remote.add_argument("--remote-cache-timeout", type=float, metavar="SECONDS",
+                        help="give up on a server that does not answer within this time, and build "
+                             "locally (default: 10)")
+    remote.add_argument("--compiler-cache", choices=("ccache", "sccache", "none"),
+                        help="compile CMake packages through ccache or sccache (on the remote cache's server "
+                             "too, when one is set)")
+    remote.add_argument("--compiler-cache-dir", metavar="DIR",
+                        help="the compiler cache's local directory (default: the tool's own)")
     cmake = parser.add_argument_group("cmake and ament_cmake packages")
     cmake.add_argument("--cmake-target", help="build this target instead of the default one (no install)")
     cmake.add_argument("--cmake-target-skip-unavailable", action="store_true",
@@ -115,12 +131,40 @@ def warn_about_missing_dependencies(workspace) -> None:
         warn(f"'{name}', a dependency of {', '.join(users)}, is in neither the workspace nor an underlay; {hint}")
 
 
-def _explain(args: argparse.Namespace, workspace, options) -> int:
+def _remote_cache(args: argparse.Namespace, workspace, options):
+    """The run's RemoteCache, or None when the remote cache is off or not configured. The environment
+    wins over roc.toml; the command line over both."""
+    if not (args.remote_cache or os.environ.get("ROC_REMOTE_CACHE")):
+        return None  # (nothing of the remote cache imported: a no-op build stays fast)
+    from roc.remote_cache.settings import MODE_VARIABLE, URL_VARIABLE, remote_settings
+
+    config = getattr(args, "configuration", None)
+    given = {}
+    for dest, variable in (("remote_cache", URL_VARIABLE), ("remote_cache_mode", MODE_VARIABLE)):
+        from_file = config is not None and config.from_configuration(args, dest)
+        given[dest] = None if from_file and os.environ.get(variable) else getattr(args, dest)
+    settings = remote_settings(given["remote_cache"], given["remote_cache_mode"], args.remote_cache_timeout)
+    if settings is None:
+        return None
+    if settings.url.startswith("s3://"):
+        import importlib.util
+
+        if importlib.util.find_spec("boto3") is None:
+            raise UsageError("--remote-cache s3://...: boto3 is not installed; pip install 'roc[s3]' "
+                             "(or boto3) into roc's environment")
+    from roc.builder.artefact import Places
+    from roc.remote_cache.cache import RemoteCache
+
+    return RemoteCache(settings, Places(workspace.root, options.build_base, options.install_base),
+                       options.merge_install)
+
+
+def _explain(args: argparse.Namespace, workspace, options, remote) -> int:
     from roc.builder.uptodate import explain
     from roc.engine.events import task_key
     from roc.render import print_json, print_lines
 
-    explained = explain(workspace, options)
+    explained = explain(workspace, options, remote)
     if args.output == "json":
         print_json([{"package": name, "kind": kind, "reasons": reasons} for kind, name, reasons in explained])
     else:
@@ -162,17 +206,24 @@ def run(args: argparse.Namespace) -> int:
         force=args.force,
         use_state=not args.no_cache,
     )
+    remote = _remote_cache(args, workspace, options)  # bad settings: a usage error before anything is written
     if args.explain:
-        return _explain(args, workspace, options)
+        return _explain(args, workspace, options, remote)
+    compiler = None
+    if args.compiler_cache not in (None, "none"):
+        from roc.builder.compiler_cache import compiler_cache
+
+        compiler = compiler_cache(args.compiler_cache, args.compiler_cache_dir, workspace.root, options.build_base,
+                                  remote.settings if remote else None)
     warn_about_overrides(args, workspace, options.install_base)
     warn_about_missing_dependencies(workspace)
     with build_lock(options.build_base):
         prepare_build_base(options.build_base)
         prepare_install_base(options.install_base, args.merge_install)
-        return _build(args, workspace, options, switches)
+        return _build(args, workspace, options, switches, remote, compiler)
 
 
-def _build(args, workspace, options, switches: dict[str, bool]) -> int:
+def _build(args, workspace, options, switches: dict[str, bool], remote, compiler) -> int:
     from roc.builder.layout import refresh_install_scripts
     from roc.builder.plan import plan_build
     from roc.engine.executor import execute
@@ -184,14 +235,17 @@ def _build(args, workspace, options, switches: dict[str, bool]) -> int:
     jobserver = Jobserver(options.jobs)
     handlers = [*output_handlers(args, switches, workspace.root, options.build_base), durations]
     try:
-        tasks = plan_build(workspace, options, jobserver, durations.durations)
+        tasks = plan_build(workspace, options, jobserver, durations.durations, remote, compiler)
         result = execute(tasks, handlers, workers, continue_on_error=args.continue_on_error)
     finally:
         jobserver.close()
+        statistics = compiler.finish() if compiler is not None else None
+        if statistics and args.output != "json":
+            print(statistics, flush=True)
         for handler in handlers:  # e.g. the terminal's live line, when the run ended by an error
             getattr(handler, "close", lambda: None)()
     durations.save()
-    refresh_install_scripts(options.install_base, args.merge_install)
+    refresh_install_scripts(options.install_base, args.merge_install, options.build_base)
     if result.interrupted:
         return EXIT_INTERRUPTED
     return 0 if result.ok else EXIT_FAILURE

@@ -25,12 +25,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from roc.builder.cache_store import (
-        check_isolated,
-        export_cache,
-        import_cache,
-        path_dependent_file,
-    )
+    from roc.builder.artefact import Places, installed_files, path_dependent_file
+    from roc.builder.cache_store import check_isolated, export_cache, import_cache
     from roc.builder.uptodate import fingerprint_packages
     from roc.errors import UsageError
     from roc.workspace.load import load_workspace
@@ -47,13 +43,14 @@ def run(args: argparse.Namespace) -> int:
         return 0
     check_isolated(options.merge_install)
     cache = Path(args.path).absolute()
+    places = Places(workspace.root, options.build_base, options.install_base)
     if args.action == "export":
-        stored, left_out = export_cache(cache, workspace.root, options.build_base, options.install_base,
-                                        workspace.selected_in_order(),
+        stored, left_out = export_cache(cache, places, workspace.selected_in_order(),
                                         {name: state.fingerprint for name, state in states.items()})
         print(f"exported {len(stored)} up-to-date package(s) to {cache}")
         for name in stored:
-            fixed = path_dependent_file(options.install_base / name, [workspace.root, options.install_base])
+            fixed = path_dependent_file(installed_files(name, places, merged=False), options.install_base / name,
+                                        places)
             if fixed:
                 print(f"  {name}: import can restore it only into {workspace.root} ({fixed} holds that path)",
                       file=sys.stderr)
@@ -70,8 +67,7 @@ def run(args: argparse.Namespace) -> int:
     with build_lock(options.build_base):  # never replace a prefix while a build uses it
         prepare_build_base(options.build_base)
         prepare_install_base(options.install_base, merged=False)
-        restored, left_out = import_cache(cache, workspace.root, options.build_base, options.install_base,
-                                          {p.name: p for p in workspace.selected_in_order()})
+        restored, left_out = import_cache(cache, places, {p.name: p for p in workspace.selected_in_order()})
         refresh_install_scripts(options.install_base, merged=False)
     print(f"imported {len(restored)} package(s) from {cache}")
     for name, why in sorted(left_out.items()):

