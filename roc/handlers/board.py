@@ -27,8 +27,8 @@ from roc.engine.events import (
 from roc.handlers.status import progress_of
 
 # states, in the order a task goes through them
-QUEUED, RUNNING, FINISHED, CACHED, FAILED, ABORTED, SKIPPED = (
-    "queued", "running", "finished", "up to date", "failed", "aborted", "skipped")
+QUEUED, RUNNING, FINISHED, CACHED, FAILED, ABORTED, SKIPPED, NOT_STARTED = (
+    "queued", "running", "finished", "up to date", "failed", "aborted", "skipped", "not started")
 
 
 @dataclass
@@ -92,6 +92,9 @@ class TaskBoard:
     def _take(self, event: Event) -> None:
         if isinstance(event, RunFinished):
             self.finished, self.interrupted = True, event.interrupted
+            for key in event.not_started:  # the run stopped first (a failure, Ctrl+C)
+                if key in self._rows:
+                    self._rows[key].state = NOT_STARTED
             return
         if isinstance(event, TaskQueued):
             label = event.task if event.kind == self.kind else event.key

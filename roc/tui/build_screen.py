@@ -12,13 +12,13 @@ from textual.binding import Binding
 from textual.screen import Screen
 from textual.widgets import DataTable, Footer, Static
 
-from roc.handlers.board import ABORTED, FAILED, RUNNING, SKIPPED, TaskRow
+from roc.handlers.board import ABORTED, FAILED, NOT_STARTED, QUEUED, RUNNING, SKIPPED, TaskRow
 from roc.handlers.console import format_duration
 from roc.tui.model import Row
 from roc.tui.widgets import ListTable, TextViewer
 
 REDRAW_SECONDS = 0.25
-PROBLEMS = {FAILED: "failed", ABORTED: "aborted", SKIPPED: "skipped"}
+PROBLEMS = {FAILED: "failed", ABORTED: "aborted", SKIPPED: "skipped", NOT_STARTED: "not started"}
 
 
 def board_row(row: TaskRow, now: float) -> Row:
@@ -30,7 +30,7 @@ def board_row(row: TaskRow, now: float) -> Row:
 
 
 def progress_text(rows: list[TaskRow], seconds: float, finished: bool, interrupted: bool) -> str:
-    done = sum(1 for r in rows if r.state not in ("queued", RUNNING))
+    done = sum(1 for r in rows if r.state not in (QUEUED, RUNNING, NOT_STARTED))
     running = sum(1 for r in rows if r.state == RUNNING)
     failed = sum(1 for r in rows if r.state == FAILED)
     state = "interrupted" if interrupted else "finished" if finished else "building"

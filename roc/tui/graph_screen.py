@@ -41,7 +41,8 @@ class GraphScreen(Screen):
         Binding("4", "show_tab('actions')", "actions", show=False),
         Binding("5", "show_tab('packages')", "packages (in a workspace)", show=False),
         Binding("f", "frames", "tf frames"),
-        Binding("b", "build", "build (in a workspace)", show=False),
+        Binding("b", "build", "build the package under the cursor and what it needs (Packages)", show=False),
+        Binding("B", "build(True)", "build the whole workspace (Packages)", show=False),
         Binding("H", "toggle_hidden", "show hidden names", show=False),
     ]
     DEFAULT_CSS = """
@@ -197,14 +198,14 @@ class GraphScreen(Screen):
             self.query_one("#tabs", TabbedContent).active = tab
 
     def action_frames(self) -> None:
-        host(self).open("frames", "")
+        host(self).open("frame", "")
 
-    def action_build(self) -> None:
+    def action_build(self, everything: bool = False) -> None:
         if self.workspace is None:
             self.notify("not in a workspace: run roc tui in one to build", severity="warning")
             return
         selected = self.table("packages").selected_key() if self.active_tab() == "packages" else None
-        host(self).start_build([selected] if selected else [])
+        host(self).start_build([selected] if selected and not everything else [])
 
     def action_toggle_hidden(self) -> None:
         self.hidden = not self.hidden

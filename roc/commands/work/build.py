@@ -124,14 +124,17 @@ def _check_supported(args: argparse.Namespace) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.tui and not args.explain:
+        from roc.tui.app import require_terminal
+
+        require_terminal("--tui")
     workspace, options, switches = _prepare(args)
     if args.explain:
         return _explain(args, workspace, options)
     warn_about_overrides(args, workspace, options.install_base)
     if args.tui:
-        from roc.tui.app import require_terminal, run_build_app
+        from roc.tui.app import run_build_app
 
-        require_terminal("--tui")
         return run_build_app(partial(_locked_build, args, workspace, options, switches), verb="build")
     return _locked_build(args, workspace, options, switches)
 
