@@ -75,6 +75,16 @@ if ! command -v zsh >/dev/null 2>&1 || ! command -v fish >/dev/null 2>&1; then
     fi
 fi
 
+# ---- tmux, for the test that runs roc tui in a real terminal (tests/test_tui_terminal.py; a test-time
+# tool only, roc never needs it; without it that test is skipped outside CI) --------------------
+if ! command -v tmux >/dev/null 2>&1; then
+    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+        say "installing tmux (apt-get) for the test that runs roc tui in a real terminal"
+        { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq tmux; } >/dev/null 2>&1 \
+            || say "could not install tmux; the terminal test of roc tui will be skipped"
+    fi
+fi
+
 # ---- venv -------------------------------------------------------------------------------
 if [ ! -x "$VPY" ] || ! "$VPY" -c '' >/dev/null 2>&1; then
     command -v "$PYTHON" >/dev/null 2>&1 || die "'$PYTHON' not found (set PYTHON=/path/to/python3.11)"

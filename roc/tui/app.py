@@ -4,6 +4,7 @@ while the TUI shows it."""
 
 from __future__ import annotations
 
+import os
 import sys
 from collections.abc import Callable
 from functools import partial
@@ -61,8 +62,9 @@ class RocApp(App[int]):
     def __init__(self, feed: Feed | None = None, workspace: WorkspaceView | None = None,
                  build: Start | None = None, new_build: Callable[[list[str]], Start] | None = None) -> None:
         """``build``: show this build at once (``roc work build --tui``) instead of the graph;
-        ``new_build``: how to build packages of the workspace from the TUI."""
-        super().__init__()
+        ``new_build``: how to build packages of the workspace from the TUI. With NO_COLOR set, no
+        colour at all (Textual alone would draw in greys), styles such as bold and reverse kept."""
+        super().__init__(ansi_color=True if os.environ.get("NO_COLOR") else None)
         self.new_build = new_build
         self.feed = feed or Feed()
         self.workspace = workspace

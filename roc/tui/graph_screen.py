@@ -23,7 +23,7 @@ REFRESH_SECONDS = 1.0
 # tab id -> (title, columns, marks)
 LISTS = {
     "nodes": ("Nodes", ("node",), True),
-    "topics": ("Topics", ("topic", "type", "pub", "sub", "rate", "bandwidth"), True),
+    "topics": ("Topics", ("topic", "pub", "sub", "rate", "bandwidth", "type"), True),
     "services": ("Services", ("service", "type"), False),
     "actions": ("Actions", ("action", "type"), False),
 }
@@ -32,6 +32,8 @@ LISTS = {
 class GraphScreen(Screen):
     BINDINGS = [
         Binding("slash", "filter", "filter"),
+        # priority: Enter in the filter must not also reach the list it focuses (a race in a terminal)
+        Binding("enter", "enter", "open (in the filter: keep it)", show=False, priority=True),
         Binding("escape", "clear_filter", "clear the filter", show=False),
         Binding("tab", "switch_tab(1)", "next list", show=False),
         Binding("shift+tab", "switch_tab(-1)", "previous list", show=False),
@@ -46,11 +48,12 @@ class GraphScreen(Screen):
         Binding("H", "toggle_hidden", "show hidden names", show=False),
     ]
     DEFAULT_CSS = """
-    #header { height: 1; background: $primary; color: $text; }
-    #detail { height: 2; color: $text-muted; }
-    #filter { dock: bottom; display: none; }
-    ListTable { height: 1fr; }
-    TabbedContent { height: 1fr; }
+    GraphScreen { overflow: hidden; }
+    GraphScreen #header { height: 1; background: $primary; color: $text; }
+    GraphScreen #detail { height: 2; color: $text-muted; }
+    GraphScreen #filter { display: none; }
+    GraphScreen ListTable { height: 1fr; }
+    GraphScreen #tabs { height: 1fr; }
     """
 
     def __init__(self, workspace=None) -> None:
@@ -61,6 +64,7 @@ class GraphScreen(Screen):
         self.snapshot: dict[str, Any] | None = None
         self.measured: list[str] = []  # the topics the rates stream measures
         self.status = "connecting to the roc daemon..."
+        self.workspace_error = ""
 
     def compose(self) -> ComposeResult:
         yield Static(self.status, id="header")
@@ -124,7 +128,12 @@ class GraphScreen(Screen):
             self.app.call_from_thread(self.show_status, f"rates: {error}")
 
     def show_packages(self) -> None:
-        self.table("packages").show(self.workspace.rows())
+        try:
+            self.table("packages").show(self.workspace.rows())
+        except RocError as error:  # a workspace roc work list would refuse too
+            if str(error) != self.workspace_error:
+                self.workspace_error = str(error)
+                self.notify(f"workspace {self.workspace.root}: {error}", severity="error", timeout=10)
 
     # -- views -----------------------------------------------------------------------------------
     def table(self, tab: str) -> ListTable:
@@ -173,10 +182,13 @@ class GraphScreen(Screen):
             self.table(self.active_tab()).set_filter(event.value)
             self.show_detail()
 
-    def on_input_submitted(self, event: Input.Submitted) -> None:
-        if event.input.id == "filter":
-            event.input.display = bool(event.value)
+    def action_enter(self) -> None:
+        focused = self.focused
+        if isinstance(focused, Input):
+            focused.display = bool(focused.value)
             self.table(self.active_tab()).focus()
+        elif isinstance(focused, DataTable):
+            focused.action_select_cursor()
 
     def action_clear_filter(self) -> None:
         box = self.query_one("#filter", Input)

@@ -33,6 +33,22 @@ def matches(needle: str, *texts: str) -> bool:
     return all(word in haystack for word in needle.lower().split())
 
 
+def shown_endpoints(endpoints: dict[str, Any]) -> dict[str, Any]:
+    """A topic's endpoints less those of hidden nodes (ros2's rule), such as the roc daemon's own
+    subscriptions that measure the rates: they would count as subscribers."""
+    return {side: [e for e in endpoints[side] if not is_hidden(e["node_name"])]
+            for side in ("publishers", "subscribers")}
+
+
+def with_shown_endpoints(topic: dict[str, Any]) -> dict[str, Any]:
+    """A ``snapshot`` topic whose counts leave hidden nodes out (when its endpoints are known)."""
+    if not topic.get("endpoints"):
+        return topic
+    endpoints = shown_endpoints(topic["endpoints"])
+    return {**topic, "endpoints": endpoints, "publishers": len(endpoints["publishers"]),
+            "subscribers": len(endpoints["subscribers"])}
+
+
 def diagnoses(topic: dict[str, Any]) -> list[str]:
     """What is wrong with a topic of a ``snapshot`` (with endpoints): nobody publishes or nobody
     listens, and the QoS and type problems ``roc topic info -v`` reports (roc.ros.present)."""
@@ -85,14 +101,15 @@ class Rates:
 
 
 def visible(entries: list[dict[str, Any]], hidden: bool) -> list[dict[str, Any]]:
-    """Entries without a hidden name (ros2's rule), unless ``hidden``."""
-    return entries if hidden else [e for e in entries if not is_hidden(e.get("full_name", e["name"]))]
+    """Entries without a hidden name (ros2's rule), unless ``hidden``; topics counted without the
+    endpoints of hidden nodes."""
+    shown = entries if hidden else [e for e in entries if not is_hidden(e.get("full_name", e["name"]))]
+    return [with_shown_endpoints(e) if "endpoints" in e and not hidden else e for e in shown]
 
 
 def topic_rows(snapshot: dict[str, Any], rates: Rates, hidden: bool = False) -> list[Row]:
-    return [Row(t["name"], (t["name"], ", ".join(t["types"]), str(t["publishers"]), str(t["subscribers"]),
-                            rate_text(rates.rate(t["name"])), bandwidth_text(rates.bandwidth(t["name"]))),
-                diagnoses(t))
+    return [Row(t["name"], (t["name"], str(t["publishers"]), str(t["subscribers"]), rate_text(rates.rate(t["name"])),
+                            bandwidth_text(rates.bandwidth(t["name"])), ", ".join(t["types"])), diagnoses(t))
             for t in visible(snapshot["topics"], hidden)]
 
 

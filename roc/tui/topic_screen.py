@@ -18,7 +18,7 @@ from textual.worker import get_current_worker
 
 from roc.errors import RocError
 from roc.ros.rates import Sample, Window
-from roc.tui.model import TOPIC_WINDOW, Row, bandwidth_text, diagnoses, endpoint_cells, rate_text
+from roc.tui.model import TOPIC_WINDOW, Row, bandwidth_text, diagnoses, endpoint_cells, rate_text, shown_endpoints
 from roc.tui.widgets import ListTable, Prompt, host
 
 ECHO_SECONDS = 0.25  # the echo pane shows the latest message at most this often
@@ -93,6 +93,7 @@ class TopicScreen(Screen):
         self.app.call_from_thread(self.show_endpoints, info)
 
     def show_endpoints(self, info: dict[str, Any]) -> None:
+        info = {**info, **shown_endpoints(info)}
         rows = [Row(endpoint["gid"], endpoint_cells(endpoint)) for endpoint in info["publishers"] + info["subscribers"]]
         self.query_one("#endpoints", ListTable).show(rows)
         problems = diagnoses({**info, "publishers": len(info["publishers"]), "subscribers": len(info["subscribers"]),

@@ -49,9 +49,13 @@ MARKS = {"error": "!! ", "warning": "!  ", "": "   "}  # still seen without colo
 
 class ListTable(DataTable):
     """Rows (roc.tui.model.Row) shown as a table: on each ``show`` only changed cells are redrawn, and
-    the cursor stays on the row it was on. ``filter`` keeps the rows whose cells match it."""
+    the cursor stays on the row it was on. ``filter`` keeps the rows whose cells match it. Without
+    colour (NO_COLOR: ANSI mode), the cursor's row is drawn in reverse video."""
 
-    BINDINGS = [Binding("enter", "select_cursor", "open", show=False)]
+    DEFAULT_CSS = """
+    ListTable:ansi > .datatable--cursor { text-style: reverse; }
+    ListTable:ansi > .datatable--header { text-style: bold underline; }
+    """
 
     def __init__(self, columns: tuple[str, ...], marks: bool = False, **options) -> None:
         super().__init__(cursor_type="row", zebra_stripes=False, **options)
@@ -93,7 +97,7 @@ class ListTable(DataTable):
                 if old == row:
                     continue
                 for column, value in zip(columns, self._cells(row)):
-                    self.update_cell(row.key, column, value)
+                    self.update_cell(row.key, column, value, update_width=True)
         self._shown = keys
         self.rows_by_key = {r.key: r for r in shown}
 
