@@ -83,7 +83,8 @@ def test_a_build_started_from_the_packages_list(tmp_path: Path, monkeypatch) -> 
     from roc.tui.packages import WorkspaceView
 
     root = make_workspace(tmp_path / "ws")
-    env = graph_env(37, tmp_path / "runtime", **{k: v for k, v in ros_env().items() if k in ("AMENT_PREFIX_PATH", "PATH")})
+    tools = {k: v for k, v in ros_env().items() if k in ("AMENT_PREFIX_PATH", "PATH")}
+    env = graph_env(37, tmp_path / "runtime", **tools)
     (tmp_path / "runtime").mkdir()
     for name, value in env.items():
         monkeypatch.setenv(name, value)

@@ -79,6 +79,8 @@ class TaskBoard:
     finished: bool = False
     interrupted: bool = False
     changes: int = 0  # counts every change, so a view redraws only when it moved
+    started_at: float | None = None  # the time of the run's first event, and of its end (time.time())
+    ended_at: float | None = None
 
     def rows(self) -> list[TaskRow]:
         with self._lock:
@@ -90,8 +92,9 @@ class TaskBoard:
             self.changes += 1
 
     def _take(self, event: Event) -> None:
+        self.started_at = event.time if self.started_at is None else self.started_at
         if isinstance(event, RunFinished):
-            self.finished, self.interrupted = True, event.interrupted
+            self.finished, self.interrupted, self.ended_at = True, event.interrupted, event.time
             for key in event.not_started:  # the run stopped first (a failure, Ctrl+C)
                 if key in self._rows:
                     self._rows[key].state = NOT_STARTED

@@ -68,7 +68,9 @@ class BuildScreen(Screen):
         rows = board.rows()
         now = time.monotonic()
         self.query_one("#tasks", ListTable).show([board_row(row, now) for row in rows])
-        text = progress_text(rows, now - self.build.started, board.finished, board.interrupted)
+        ended = board.ended_at is not None and board.started_at is not None
+        took = board.ended_at - board.started_at if ended else now - self.build.started  # type: ignore[operator]
+        text = progress_text(rows, took, board.finished, board.interrupted)
         if self.build.error:
             text += f"  error: {self.build.error}"
         self.query_one("#progress", Static).update(Text(text, style="bold"))

@@ -15,6 +15,7 @@ from textual.widgets import DataTable, Footer, Input, Static, TabbedContent, Tab
 from textual.worker import get_current_worker
 
 from roc.errors import RocError
+from roc.ros.present import plural
 from roc.tui.feed import measure_rates
 from roc.tui.model import Rates, counts, node_rows, topic_rows, typed_rows, visible
 from roc.tui.widgets import ListTable, host
@@ -104,9 +105,9 @@ class GraphScreen(Screen):
     def show_snapshot(self, snapshot: dict[str, Any]) -> None:
         self.snapshot = snapshot
         number = counts(snapshot, self.hidden)
-        problems = f"  {number['problems']} topic(s) with problems" if number["problems"] else ""
-        self.show_status(f"roc tui  {number['nodes']} nodes  {number['topics']} topics  {number['services']} "
-                         f"services  {number['actions']} actions{problems}")
+        problems = f"  {plural(number['problems'], 'topic')} with problems" if number["problems"] else ""
+        self.show_status("roc tui  " + "  ".join(plural(number[kind], kind.rstrip("s"))
+                                                 for kind in ("nodes", "topics", "services", "actions")) + problems)
         self.table("nodes").show(node_rows(snapshot, self.hidden))
         self.table("topics").show(topic_rows(snapshot, self.rates, self.hidden))
         self.table("services").show(typed_rows(snapshot["services"], self.hidden))

@@ -74,9 +74,9 @@ class ListTable(DataTable):
 
     def _cells(self, row: Row) -> list:
         style = STYLES[severity(row.problems)]
-        cells: list = [Text(cell, style=style) if style else cell for cell in row.cells]
+        cells: list = [Text(cell, style=style) for cell in row.cells]  # never Rich markup: "[1, 2]" is a value
         if self.marks:
-            cells.insert(0, MARKS[severity(row.problems)].strip())
+            cells.insert(0, Text(MARKS[severity(row.problems)].strip(), style=style))
         return cells
 
     def show(self, rows: Iterable[Row]) -> None:
