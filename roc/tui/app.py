@@ -8,17 +8,20 @@ import os
 import sys
 from collections.abc import Callable
 from functools import partial
+from typing import TYPE_CHECKING
 
 from textual.app import App
 from textual.binding import Binding
 from textual.command import DiscoveryHit, Hit, Hits, Provider
 
 from roc.errors import RocError, UsageError
-from roc.tui.build_run import BuildRun, Start
 from roc.tui.feed import Feed
 from roc.tui.graph_screen import GraphScreen
 from roc.tui.packages import WorkspaceView
 from roc.tui.widgets import TextViewer, binding_lines
+
+if TYPE_CHECKING:  # builds load the engine's modules only when one starts
+    from roc.tui.build_run import BuildRun, Start
 
 
 class GraphCommands(Provider):
@@ -74,6 +77,7 @@ class RocApp(App[int]):
 
     def on_mount(self) -> None:
         if self._first_build is not None:
+            from roc.tui.build_run import BuildRun
             from roc.tui.build_screen import BuildScreen
 
             self.build = BuildRun(self._first_build)
@@ -111,6 +115,7 @@ class RocApp(App[int]):
 
     def start_build(self, packages: list[str]) -> None:
         """Build ``packages`` (all when empty) of the workspace and show it; one build at a time."""
+        from roc.tui.build_run import BuildRun
         from roc.tui.build_screen import BuildScreen
 
         if self.new_build is None:

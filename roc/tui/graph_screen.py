@@ -21,6 +21,8 @@ from roc.tui.model import Rates, counts, node_rows, topic_rows, typed_rows, visi
 from roc.tui.widgets import ListTable, host
 
 REFRESH_SECONDS = 1.0
+# the topics' columns whose values change every second, at the widths of their longest values
+TOPIC_WIDTHS = {"pub": 3, "sub": 3, "rate": 9, "bandwidth": 11}
 # tab id -> (title, columns, marks)
 LISTS = {
     "nodes": ("Nodes", ("node",), True),
@@ -64,7 +66,7 @@ class GraphScreen(Screen):
         self.hidden = False
         self.snapshot: dict[str, Any] | None = None
         self.measured: list[str] = []  # the topics the rates stream measures
-        self.status = "connecting to the roc daemon..."
+        self.status = "roc tui  connecting to the roc daemon..."
         self.workspace_error = ""
 
     def compose(self) -> ComposeResult:
@@ -72,7 +74,8 @@ class GraphScreen(Screen):
         with TabbedContent(initial="topics", id="tabs"):
             for tab, (title, columns, marks) in LISTS.items():
                 with TabPane(title, id=tab):
-                    yield ListTable(columns, marks=marks, id=f"{tab}-table")
+                    widths = TOPIC_WIDTHS if tab == "topics" else None
+                    yield ListTable(columns, marks=marks, id=f"{tab}-table", widths=widths)
             if self.workspace is not None:
                 with TabPane("Packages", id="packages"):
                     yield ListTable(self.workspace.COLUMNS, marks=True, id="packages-table")

@@ -91,8 +91,7 @@ class Rates:
 
     def rate(self, topic: str) -> float | None:
         window = self.windows.get(topic)
-        measured = window.rate() if window else None
-        return measured["rate"] if measured else None
+        return window.frequency() if window else None
 
     def bandwidth(self, topic: str) -> float | None:
         window = self.windows.get(topic)

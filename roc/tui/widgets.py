@@ -12,6 +12,7 @@ from textual.binding import Binding, BindingType
 from textual.containers import Vertical
 from textual.screen import ModalScreen
 from textual.widgets import DataTable, Input, Static, TextArea
+from textual.widgets.data_table import ColumnKey
 
 from roc.tui.feed import Feed
 from roc.tui.model import NO_PUBLISHER, NO_SUBSCRIBER, Row, matches
@@ -57,9 +58,13 @@ class ListTable(DataTable):
     ListTable:ansi > .datatable--header { text-style: bold underline; }
     """
 
-    def __init__(self, columns: tuple[str, ...], marks: bool = False, **options) -> None:
+    def __init__(self, columns: tuple[str, ...], marks: bool = False, widths: dict[str, int] | None = None,
+                 **options) -> None:
+        """``widths``: columns of a fixed width, for values that change all the time (rates): a
+        column sized to its content is measured again, row by row, whenever a cell outgrows it."""
         super().__init__(cursor_type="row", zebra_stripes=False, **options)
         self.columns_names = columns
+        self.widths = widths or {}
         self.marks = marks  # a first column of marks for rows with problems
         self.filter = ""
         self.rows_by_key: dict[str, Row] = {}
@@ -70,7 +75,7 @@ class ListTable(DataTable):
         if self.marks:
             self.add_column("", key="!", width=2)
         for name in self.columns_names:
-            self.add_column(name, key=name)
+            self.add_column(name, key=name, width=self.widths.get(name))
 
     def _cells(self, row: Row) -> list:
         style = STYLES[severity(row.problems)]
@@ -96,8 +101,11 @@ class ListTable(DataTable):
                 old = self.rows_by_key.get(row.key)
                 if old == row:
                     continue
-                for column, value in zip(columns, self._cells(row)):
-                    self.update_cell(row.key, column, value, update_width=True)
+                for column, value, before in zip(columns, self._cells(row), self._cells(old) if old else []):
+                    if value != before:
+                        width = self.columns[ColumnKey(column)].content_width
+                        grows = column not in self.widths and value.cell_len > width
+                        self.update_cell(row.key, column, value, update_width=grows)
         self._shown = keys
         self.rows_by_key = {r.key: r for r in shown}
 
