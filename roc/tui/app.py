@@ -131,8 +131,9 @@ class RocApp(App[int]):
         self.push_screen(BuildScreen(self.build))
 
     def action_help(self) -> None:
-        lines = binding_lines(f"{type(self.screen).__name__.removesuffix('Screen')} screen", self.screen.BINDINGS)
-        lines += binding_lines("everywhere", self.BINDINGS)
+        screen = type(self.screen).__name__.removesuffix("Screen")
+        lines = binding_lines(f"{screen} screen", self.screen.BINDINGS, self.get_key_display)
+        lines += binding_lines("everywhere", self.BINDINGS, self.get_key_display)
         lines += ["Arrows, Page Up/Down, Home/End move in a list; Enter opens what is under the cursor;",
                   "Esc goes back (or clears the filter). In an input: Enter accepts, Esc cancels."]
         self.push_screen(TextViewer("keys (Esc: back)", "\n".join(lines)))

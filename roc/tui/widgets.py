@@ -3,7 +3,7 @@ a one-line prompt, a text viewer and the help screen."""
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Protocol, cast
 
 from rich.text import Text
@@ -175,11 +175,11 @@ class TextViewer(ModalScreen[None]):
         self.dismiss(None)
 
 
-def binding_lines(title: str, bindings: Iterable[BindingType]) -> list[str]:
-    """One line per key binding: its keys and what it does."""
+def binding_lines(title: str, bindings: Iterable[BindingType], display: Callable[[Binding], str]) -> list[str]:
+    """One line per key binding: its keys as ``display`` shows a key (``/``, ``esc``) and what it does."""
     lines = []
     for binding in bindings:
         if isinstance(binding, Binding) and binding.description:
-            keys = ", ".join(k.strip() for k in binding.key.split(","))
+            keys = ", ".join(display(Binding(key.strip(), binding.action)) for key in binding.key.split(","))
             lines.append(f"  {keys:<18} {binding.description}")
     return [title, *lines, ""] if lines else []
