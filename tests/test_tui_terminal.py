@@ -100,7 +100,8 @@ def test_graph_in_a_terminal_filter_and_quit(tmp_path: Path, no_color: bool) -> 
         terminal.keys("chat", literal=True)
         terminal.wait(lambda s: "filter 'chat'" in s, "the filter applied")
         terminal.keys("Enter")
-        screen = terminal.wait(lambda s: "/rosout" not in s and "filter 'chat'" in s, "the filter")
+        screen = terminal.wait(lambda s: "/rosout" not in s and "filter 'chat'" in s and "filter: words" not in s
+                               and "▔" not in s, "the filter kept, its input closed")
         assert "/chatter" in screen
         terminal.keys("q")
         assert terminal.exit_code() == 0

@@ -152,7 +152,8 @@ class GraphScreen(Screen):
         row = table.selected()
         text = "; ".join(row.problems) if row and row.problems else ""
         if table.filter:
-            text = f"filter '{table.filter}': {table.shown_count} shown" + (f"  |  {text}" if text else "")
+            text = (f"filter '{table.filter}': {table.shown_count} shown (/ changes it, Esc clears it)"
+                    + (f"  |  {text}" if text else ""))
         self.query_one("#detail", Static).update(Text(text))
 
     def on_data_table_row_highlighted(self, _event: DataTable.RowHighlighted) -> None:
@@ -188,8 +189,8 @@ class GraphScreen(Screen):
 
     def action_enter(self) -> None:
         focused = self.focused
-        if isinstance(focused, Input):
-            focused.display = bool(focused.value)
+        if isinstance(focused, Input):  # the filter stays, said under the list
+            focused.display = False
             self.table(self.active_tab()).focus()
         elif isinstance(focused, DataTable):
             focused.action_select_cursor()
