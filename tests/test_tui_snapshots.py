@@ -13,8 +13,9 @@ import re
 from pathlib import Path
 
 import pytest
-from graph_helpers import DEMO_GRAPH, REPO, graph_env, start_nodes, stop_all, stop_daemon
-from test_tui import SIZE, open_row, table, until
+from graph_helpers import DEMO_GRAPH, REPO, graph_env
+from test_tui import SIZE, live_graph, open_row, table, until
+from textual.widgets.data_table import ColumnKey
 
 from roc.engine.events import (
     CommandStarted,
@@ -51,17 +52,8 @@ class StillFeed(Feed):
 
 @pytest.fixture(scope="module")
 def graph(tmp_path_factory):
-    env = graph_env(39, tmp_path_factory.mktemp("runtime"))
-    saved = dict(os.environ)
-    os.environ.update(env)
-    processes = start_nodes([*DEMO_GRAPH, *EXTRA], env)
-    try:
+    with live_graph(graph_env(39, tmp_path_factory.mktemp("runtime")), [*DEMO_GRAPH, *EXTRA]) as env:
         yield env
-    finally:
-        stop_all(processes)
-        stop_daemon(env)
-        os.environ.clear()
-        os.environ.update(saved)
 
 
 def check(app, name: str) -> None:
@@ -113,7 +105,11 @@ def test_main_screens(graph) -> None:
             check(app, "help")
             await pilot.press("escape")
             await open_row(app, pilot, "nodes", "/motor_controller")
-            await until(pilot, lambda: len(table(app, "#parameters").rows_by_key) == 8, what="the parameters")
+            parameters = table(app, "#parameters")
+            await until(pilot, lambda: len(parameters.rows_by_key) == 8, what="the parameters")
+            widest = len("start_type_description_service")
+            await until(pilot, lambda: parameters.columns[ColumnKey("parameter")].content_width >= widest,
+                        what="the columns' widths")
             await pilot.pause(0.5)
             check(app, "node")
     asyncio.run(test())
