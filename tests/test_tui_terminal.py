@@ -9,16 +9,18 @@ import re
 import shlex
 import shutil
 import subprocess
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
 
 import pytest
-from build_helpers import BIN, ros_env
-from graph_helpers import graph_env, start_nodes, stop_all, stop_daemon
+from build_helpers import BIN, REPO, ros_env, stop_process
+from graph_helpers import graph_env, read_line, start_nodes, stop_all, stop_daemon
 from test_tui_build import make_workspace
 
 pytestmark = pytest.mark.slow
+TF_NODE = Path(__file__).resolve().parent / "tf_node.py"
 
 if shutil.which("tmux") is None:
     if os.environ.get("CI"):
@@ -34,7 +36,8 @@ class Terminal:
         self.socket = directory / "tmux.sock"
         self.status = directory / "status"
         script = directory / "run.sh"
-        exports = "".join(f"export {name}={shlex.quote(value)}\n" for name, value in env.items())
+        exports = "".join(f"export {name}={shlex.quote(value)}\n" for name, value in env.items()
+                          if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name))
         script.write_text(f"{exports}cd {shlex.quote(str(cwd))}\n{shlex.join(command)}\n"
                           f"echo $? > {shlex.quote(str(self.status))}\nsleep 60\n")
         config = directory / "tmux.conf"
@@ -125,3 +128,38 @@ def test_work_build_tui_in_a_terminal(tmp_path: Path) -> None:
         assert "1 package failed: broken" in screen and "skipped because a dependency failed: after" in screen
     finally:
         terminal.close()
+
+
+def test_the_tf_tree_in_a_terminal(tmp_path: Path) -> None:
+    """The tf screen (f): each frame under its parent with its rate and publishing node, live; tf2_msgs
+    built by roc from the example workspace and sourced, the tree published by tests/tf_node.py."""
+    workspace = tmp_path / "tf"
+    shutil.copytree(REPO / "workspaces" / "example" / "src" / "tf2_msgs", workspace / "src" / "tf2_msgs")
+    built = subprocess.run([str(BIN / "roc"), "work", "build"], cwd=workspace, env=ros_env(), capture_output=True,
+                           text=True, timeout=600)
+    assert built.returncode == 0, built.stdout + built.stderr
+    (tmp_path / "runtime").mkdir()
+    env = graph_env(38, tmp_path / "runtime", TERM="xterm-256color")
+    dumped = subprocess.run(["bash", "-c", f'source "{workspace}/install/setup.bash" && env -0'], env=env,
+                            capture_output=True, timeout=60, check=True)
+    env = dict(item.split("=", 1) for item in dumped.stdout.decode().split("\0") if "=" in item)
+    publisher = subprocess.Popen([sys.executable, str(TF_NODE), "publish"], env=env, stdout=subprocess.PIPE,
+                                 stderr=subprocess.DEVNULL, text=True)
+    terminal = Terminal(tmp_path, [str(BIN / "roc"), "tui", "--no-workspace"], env, tmp_path)
+    try:
+        assert read_line(publisher, 60) == "ready\n"
+        terminal.wait(lambda s: "/tf_static" in s, "the graph")
+        terminal.keys("f")
+        screen = terminal.wait(lambda s: re.search(r"base_link \[(19|20)\.\d Hz, /tf_publish\]", s) is not None,
+                               "the tree with its rates")
+        lines = [line.strip() for line in screen.splitlines()]
+        assert "map" in lines and "└── odom [static, /tf_publish]" in lines, screen
+        assert "└── laser [static, /tf_publish]" in lines, screen
+        terminal.keys("Escape")  # then wait: Esc and q at once read as Alt+Q
+        terminal.wait(lambda s: "Topics" in s and "tf frames (from" not in s, "the graph again")
+        terminal.keys("q")
+        assert terminal.exit_code() == 0
+    finally:
+        terminal.close()
+        stop_process(publisher)
+        stop_daemon(env)
