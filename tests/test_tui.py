@@ -223,3 +223,24 @@ def test_help_lists_every_key_and_q_quits(graph) -> None:
             await until(pilot, lambda: not app.is_running, what="the app to quit")
         assert app.return_value == 0
     drive(test)
+
+
+def test_tab_keys_and_the_command_palette(graph) -> None:
+    async def test() -> None:
+        app = RocApp()
+        async with app.run_test(size=SIZE) as pilot:
+            await until(pilot, lambda: "/motor_controller/enable" in table(app, "#services-table").rows_by_key)
+            tabs = app.screen.query_one("#tabs")
+            assert tabs.active == "topics"
+            await pilot.press("tab")
+            await until(pilot, lambda: tabs.active == "services")
+            await pilot.press("shift+tab", "shift+tab")
+            await until(pilot, lambda: tabs.active == "nodes")
+            await pilot.press("colon")
+            await until(pilot, lambda: type(app.screen).__name__ == "CommandPalette")
+            await pilot.press(*"node motor_con")
+            await pilot.pause(0.5)
+            await pilot.press("enter")
+            await until(pilot, lambda: type(app.screen).__name__ == "NodeScreen", what="the node, from the palette")
+            assert app.screen.node == "/motor_controller"
+    drive(test)

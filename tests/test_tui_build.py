@@ -8,6 +8,7 @@ import os
 import subprocess
 from pathlib import Path
 
+import psutil
 import pytest
 from build_helpers import BIN, ros_env
 from graph_helpers import graph_env, stop_daemon
@@ -127,3 +128,34 @@ def test_tui_options_need_a_terminal(tmp_path: Path) -> None:
         assert done.returncode == 2 and done.stderr.startswith("roc: error: ") and "needs a terminal" in done.stderr, \
             done.stderr
         assert not (root / "build").exists()
+
+
+@pytest.mark.slow
+def test_x_stops_a_build_and_its_processes(tmp_path: Path, monkeypatch) -> None:
+    """A package whose configure step sleeps: x stops the build (its process tree ends), then q quits
+    with the code of an interrupted build."""
+    from roc.commands.work.build import build_runner
+    from roc.tui.app import RocApp
+
+    package = tmp_path / "ws" / "src" / "slow"
+    package.mkdir(parents=True)
+    (package / "CMakeLists.txt").write_text(CMAKE.format(name="slow", extra="execute_process(COMMAND sleep 300)\n"))
+    (package / "package.xml").write_text(MANIFEST.format(name="slow", depends=""))
+    for name, value in ros_env().items():
+        monkeypatch.setenv(name, value)
+    monkeypatch.chdir(package.parents[1])
+
+    def sleepers() -> list[psutil.Process]:
+        return [p for p in psutil.Process().children(recursive=True) if p.name() == "sleep"]
+
+    async def test() -> None:
+        app = RocApp(build=build_runner([]))
+        async with app.run_test(size=SIZE) as pilot:
+            await until(pilot, lambda: sleepers() != [], 60, "the configure step to start")
+            await pilot.press("x")
+            await until(pilot, lambda: app.build.board.finished, 30, "the build to stop")
+            assert {row.key: row.state for row in app.build.board.rows()} == {"slow": "aborted"}
+            assert sleepers() == []
+            await pilot.press("q")
+        assert app.return_value == 130
+    asyncio.run(test())
