@@ -236,6 +236,10 @@ def test_tab_keys_and_the_command_palette(graph) -> None:
             await until(pilot, lambda: tabs.active == "services")
             await pilot.press("shift+tab", "shift+tab")
             await until(pilot, lambda: tabs.active == "nodes")
+            nodes = table(app, "#nodes-table")
+            assert not any(name.startswith("/_roc_") for name in nodes.rows_by_key)
+            await pilot.press("H")  # hidden names too: roc's daemon
+            await until(pilot, lambda: any(name.startswith("/_roc_") for name in nodes.rows_by_key), what="hidden")
             await pilot.press("colon")
             await until(pilot, lambda: type(app.screen).__name__ == "CommandPalette")
             await pilot.press(*"node motor_con")
