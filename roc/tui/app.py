@@ -164,6 +164,7 @@ def run_build_app(start: Start, verb: str = "build") -> int:
     import io
 
     from roc.handlers.console import ConsoleHandler
+    from roc.render import print_text
 
     summary = io.StringIO()
     console = ConsoleHandler(summary, start_end=False, stderr=False, kind=verb)
@@ -172,7 +173,7 @@ def run_build_app(start: Start, verb: str = "build") -> int:
         app.run()
     finally:
         code = app.build.finish() if app.build is not None else 1
-    sys.stdout.write(summary.getvalue().lstrip("\n"))
+    print_text(summary.getvalue().lstrip("\n"))
     if app.build is not None and app.build.error:
         raise RocError(app.build.error)
     return code
