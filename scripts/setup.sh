@@ -8,12 +8,13 @@
 # .venv/.roc-setup-stamp) it only re-checks the fix-ups and prints one line.
 # Only the dev/CI environment lives here: roc itself never assumes the venv's paths.
 # It changes nothing outside the checkout (and pip's cache) unless asked:
-#   ROC_SETUP_SHELLS=1  also install zsh and fish with the system's package manager (apt-get, as root),
-#                       so that the tests of roc's zsh/fish setup scripts and completions run instead of
-#                       skipping; CI sets it (.ci/run). Without it, missing shells are only reported.
+#   ROC_SETUP_TEST_TOOLS=1  also install zsh, fish and tmux with the system's package manager (apt-get, as
+#                       root), so that the tests of roc's zsh/fish setup scripts and completions and of
+#                       roc tui in a real terminal run instead of skipping; CI sets it (.ci/run). Without
+#                       it, missing tools are only reported. roc itself needs none of them.
 # Environment: PYTHON (interpreter that creates the venv, default python3),
 #              ROC_SETUP_FORCE=1 (redo the pip steps even if the stamp matches),
-#              ROC_SETUP_SHELLS=1 (see above).
+#              ROC_SETUP_TEST_TOOLS=1 (see above).
 set -euo pipefail
 
 ROOT="$(cd -- "$(dirname -- "${BASH_SOURCE[0]}")/.." && pwd -P)"
@@ -58,22 +59,23 @@ sys.exit(0 if os.path.realpath(roc.__file__).startswith(os.path.realpath(sys.arg
 EOF
 }
 
-# ---- shells the tests source roc's setup scripts in (opt-in: their tests skip without them) ----
-# Installed only with ROC_SETUP_SHELLS=1; otherwise a full set-up says which are missing.
-setup_shells() {
-    local missing=() shell
-    for shell in zsh fish; do
-        command -v "$shell" >/dev/null 2>&1 || missing+=("$shell")
+# ---- test-time tools (opt-in: their tests skip without them): the shells the tests source roc's
+# setup scripts in, and tmux, which runs roc tui in a real terminal. Installed only with
+# ROC_SETUP_TEST_TOOLS=1; otherwise a full set-up says which are missing.
+setup_test_tools() {
+    local missing=() tool
+    for tool in zsh fish tmux; do
+        command -v "$tool" >/dev/null 2>&1 || missing+=("$tool")
     done
     [ "${#missing[@]}" -gt 0 ] || return 0
-    if [ "${ROC_SETUP_SHELLS:-0}" != 1 ]; then
-        [ "$1" = quiet ] || say "${missing[*]} not installed: their tests will be skipped (ROC_SETUP_SHELLS=1 installs them)"
+    if [ "${ROC_SETUP_TEST_TOOLS:-0}" != 1 ]; then
+        [ "$1" = quiet ] || say "${missing[*]} not installed: their tests will be skipped (ROC_SETUP_TEST_TOOLS=1 installs them)"
     elif [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-        say "ROC_SETUP_SHELLS=1: installing ${missing[*]} with apt-get"
+        say "ROC_SETUP_TEST_TOOLS=1: installing ${missing[*]} with apt-get"
         { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}"; } \
             >/dev/null 2>&1 || say "could not install ${missing[*]}; their tests will be skipped"
     else
-        say "ROC_SETUP_SHELLS=1: install ${missing[*]} yourself (this needs root and apt-get)"
+        say "ROC_SETUP_TEST_TOOLS=1: install ${missing[*]} yourself (this needs root and apt-get)"
     fi
 }
 
@@ -83,14 +85,14 @@ if [ "${ROC_SETUP_FORCE:-0}" != 1 ] && [ -f "$STAMP" ] && venv_ok \
     # Cheap safety net in case a wheel was reinstalled by hand: silent when nothing changes.
     "$VPY" "$ROOT/scripts/fix_ros_wheels.py" --quiet
     "$VPY" -m compileall -q "$ROOT/roc" >/dev/null  # only what changed since the last run
-    setup_shells quiet
+    setup_test_tools quiet
     say "environment up to date ($VENV); set ROC_SETUP_FORCE=1 to redo it"
     exit 0
 fi
 
 start=$SECONDS
 export PIP_NO_INPUT=1 PIP_DISABLE_PIP_VERSION_CHECK=1
-setup_shells loud
+setup_test_tools loud
 
 # ---- venv -------------------------------------------------------------------------------
 if [ ! -x "$VPY" ] || ! "$VPY" -c '' >/dev/null 2>&1; then

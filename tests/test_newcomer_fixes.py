@@ -326,7 +326,7 @@ def test_bash_completes_positional_package_names_and_every_list_value(tmp_path: 
 @pytest.mark.slow
 def test_zsh_completes_with_the_bash_function(tmp_path: Path) -> None:
     if shutil.which("zsh") is None:
-        pytest.skip("zsh is not installed (ROC_SETUP_SHELLS=1 bash scripts/setup.sh installs it)")
+        pytest.skip("zsh is not installed (ROC_SETUP_TEST_TOOLS=1 bash scripts/setup.sh installs it)")
     script = _completion_script("zsh", tmp_path)
     assert subprocess.run(["zsh", "-n", str(script)], capture_output=True).returncode == 0
     workspace = copy_fixture("selection", tmp_path / "ws")
@@ -355,7 +355,7 @@ def test_zsh_completes_with_the_bash_function(tmp_path: Path) -> None:
 def test_fish_completes_positional_package_names_and_every_list_value(line: str, expected: list[str],
                                                                        tmp_path: Path) -> None:
     if shutil.which("fish") is None:
-        pytest.skip("fish is not installed (ROC_SETUP_SHELLS=1 bash scripts/setup.sh installs it)")
+        pytest.skip("fish is not installed (ROC_SETUP_TEST_TOOLS=1 bash scripts/setup.sh installs it)")
     script = _completion_script("fish", tmp_path)
     assert subprocess.run(["fish", "-n", str(script)], capture_output=True).returncode == 0
     workspace = copy_fixture("selection", tmp_path / "ws")

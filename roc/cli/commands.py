@@ -92,6 +92,7 @@ COMMANDS = (
     (("daemon", "status"), (), "daemon.status", "whether the roc daemon of this environment runs"),
     (("idl",), (), None, "interface definitions, converted between protobuf and ROS 2 messages"),
     (("idl", "protobuf"), (), "idl.protobuf", "convert .proto files to .msg files, or .msg files to .proto"),
+    (("tui",), (), "tui", "the terminal user interface: the running ROS graph, live, and the workspace's builds"),
     (("completion",), (), "completion", "print a shell completion script: bash, zsh or fish"),
 )
 

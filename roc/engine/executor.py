@@ -88,13 +88,16 @@ def execute(
     workers: int,
     continue_on_error: bool = False,
     kind: str = "build",
+    stop: threading.Event | None = None,
 ) -> RunResult:
     """Run ``tasks`` respecting their dependencies with at most ``workers`` at once (0: no limit).
 
     Without ``continue_on_error`` the first failure stops the running tasks (aborted) and starts no
     more; with it, only the tasks depending on a failed one are skipped. ``kind`` is the run's own kind
     of task (``build``, ``test``, ``probe``), which the final RunFinished event carries. Ctrl+C and
-    SIGTERM stop every running process tree and end the run with ``interrupted`` set. A handler that raises is reported
+    SIGTERM stop every running process tree and end the run with ``interrupted`` set, as does setting
+    ``stop`` (for a run in a thread other than the main one, where no signal reaches it: ``roc tui``).
+    A handler that raises is reported
     on stderr and left out of the rest of the run (the run goes on), except for a closed stdout
     (BrokenPipeError), which stops the run and is raised at its end.
     """
@@ -145,7 +148,7 @@ def execute(
         if isinstance(event, (TaskFinished, TaskFailed, TaskAborted)):
             running.pop(key, None)
 
-    interrupt = threading.Event()
+    interrupt = stop or threading.Event()
 
     def on_signal(signum, frame) -> None:  # noqa: ARG001
         # Only note it: raising here could leave a started task unaccounted for.

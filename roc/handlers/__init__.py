@@ -55,9 +55,10 @@ def handler_switches(values: list[str]) -> dict[str, bool]:
 
 
 def output_handlers(args: argparse.Namespace, switches: dict[str, bool], root: Path, build_base: Path,
-                    verb: str = "build", **console_options) -> list:
-    """Where a run's events go: logs, stored results, and the console (or JSON events on stdout).
-    ``verb`` is also the run's own kind of task (``build``, ``test``)."""
+                    verb: str = "build", console: bool = True, **console_options) -> list:
+    """Where a run's events go: logs, stored results, and the console (or JSON events on stdout;
+    neither without ``console``: roc tui shows the run). ``verb`` is also the run's own kind of task
+    (``build``, ``test``)."""
     from roc.handlers.console import ConsoleHandler
     from roc.handlers.logs import (
         JsonEventsHandler,
@@ -74,6 +75,8 @@ def output_handlers(args: argparse.Namespace, switches: dict[str, bool], root: P
                                    kind=verb))
     if switches["store_result"]:
         handlers.append(ResultStore(build_base, kind=verb))
+    if not console:
+        return handlers
     if args.output == "json":
         handlers.append(JsonEventsHandler(sys.stdout))
         return handlers

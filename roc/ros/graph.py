@@ -182,13 +182,18 @@ class Graph:
         return True
 
     # -- queries --------------------------------------------------------------------------------------
-    def snapshot(self) -> dict[str, Any]:
-        """Nodes, topics (with endpoint counts), services and actions."""
+    def snapshot(self, endpoints: bool = False) -> dict[str, Any]:
+        """Nodes, topics (with endpoint counts; with ``endpoints``, each topic's endpoints too, as
+        ``topic_endpoints`` gives them: one request instead of one per topic), services and actions."""
         node = self.node
         topics = _names_and_types(node.get_topic_names_and_types())
         for topic in topics:
             topic["publishers"] = node.count_publishers(topic["name"])
             topic["subscribers"] = node.count_subscribers(topic["name"])
+            if endpoints:
+                topic["endpoints"] = {
+                    "publishers": [_endpoint(i) for i in node.get_publishers_info_by_topic(topic["name"])],
+                    "subscribers": [_endpoint(i) for i in node.get_subscriptions_info_by_topic(topic["name"])]}
         return {
             "nodes": [{"name": name, "namespace": namespace, "full_name": full_name(namespace, name)}
                       for name, namespace in sorted(node.get_node_names_and_namespaces(),
@@ -314,7 +319,7 @@ class Graph:
     def handle(self, method: str, params: dict[str, Any]) -> Any:
         """One request of the daemon protocol (see docs/daemon.md)."""
         if method == "snapshot":
-            return self.snapshot()
+            return self.snapshot(params.get("endpoints", False))
         if method == "topic_endpoints":
             return self.topic_endpoints(params["topic"])
         if method == "node_info":

@@ -45,21 +45,32 @@ class Window:
             self.samples.append(sample)
 
     def rate(self, wall_time: bool = False) -> dict | None:
-        """``{rate, min, max, std_dev, window}`` (seconds between messages), or None before two samples.
-        Sequence numbers or source timestamps that do not rise in arrival order come from several
-        publishers: the messages are then counted, and their times sorted, since one publisher's
-        message can arrive after another's newer one (a transient local topic's history comes after
-        live messages)."""
-        times = sorted(s.received if wall_time or s.source is None else s.source for s in self.samples)
+        """``{rate, min, max, std_dev, window}`` (seconds between messages), or None before two samples."""
+        rate = self.frequency(wall_time)
+        if rate is None:
+            return None
+        times = self._times(wall_time)
+        deltas = [(b - a) * NS for a, b in itertools.pairwise(times)]
+        return {"rate": rate, "min": min(deltas), "max": max(deltas), "std_dev": statistics.pstdev(deltas),
+                "window": len(times)}
+
+    def frequency(self, wall_time: bool = False) -> float | None:
+        """Messages per second (the ``rate`` of ``rate()`` alone, without its statistics), or None
+        before two samples. Sequence numbers or source timestamps that do not rise in arrival order
+        come from several publishers: the messages are then counted, and their times sorted, since
+        one publisher's message can arrive after another's newer one (a transient local topic's
+        history comes after live messages)."""
+        times = self._times(wall_time)
         if len(times) < 2 or times[-1] == times[0]:
             return None
         first, last = self.samples[0], self.samples[-1]
         one_publisher = all(a.sequence is not None and b.sequence is not None and a.sequence < b.sequence
                             and (a.source or 0) <= (b.source or 0) for a, b in itertools.pairwise(self.samples))
         messages = last.sequence - first.sequence if one_publisher else len(times) - 1
-        deltas = [(b - a) * NS for a, b in itertools.pairwise(times)]
-        return {"rate": messages / ((times[-1] - times[0]) * NS), "min": min(deltas), "max": max(deltas),
-                "std_dev": statistics.pstdev(deltas), "window": len(times)}
+        return messages / ((times[-1] - times[0]) * NS)
+
+    def _times(self, wall_time: bool) -> list[int]:
+        return sorted(s.received if wall_time or s.source is None else s.source for s in self.samples)
 
     def bandwidth(self) -> dict | None:
         """``{bytes_per_second, messages, mean, min, max}`` (sizes in bytes), or None before two samples."""

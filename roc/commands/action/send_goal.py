@@ -94,19 +94,31 @@ def _interruptible():
         signal.signal(signal.SIGINT, previous)
 
 
-def _cancel(args: argparse.Namespace, goal_id: str) -> None:
-    """Cancel the goal through the action's cancel service, and say how it went."""
+def cancel_call(action_name: str, goal_id: str) -> dict:
+    """The ``call`` stream's params that ask the action's cancel service to cancel the goal."""
     from action_msgs.srv import CancelGoal
 
-    from roc.ros.cdr import decode, encode
+    from roc.ros.cdr import encode
 
-    print_text("Canceling goal...\n")
     request = CancelGoal.Request()
     request.goal_info.goal_id.uuid = list(bytes.fromhex(goal_id))
-    params = {"service": f"{args.action_name}/_action/cancel_goal", "type": "action_msgs/srv/CancelGoal",
-              "request": encode(request)}
-    for event in stream("call", params, use_daemon=not args.no_daemon):
+    return {"service": f"{action_name}/_action/cancel_goal", "type": "action_msgs/srv/CancelGoal",
+            "request": encode(request)}
+
+
+def cancel_accepted(data: str) -> bool:
+    """Whether the cancel service's response (base64 CDR) says the goal is being canceled."""
+    from action_msgs.srv import CancelGoal
+
+    from roc.ros.cdr import decode
+
+    return bool(decode(CancelGoal.Response, data).goals_canceling)
+
+
+def _cancel(args: argparse.Namespace, goal_id: str) -> None:
+    """Cancel the goal through the action's cancel service, and say how it went."""
+    print_text("Canceling goal...\n")
+    for event in stream("call", cancel_call(args.action_name, goal_id), use_daemon=not args.no_daemon):
         if event["event"] == "response":
-            canceled = decode(CancelGoal.Response, event["data"]).goals_canceling
-            print_text("Goal canceled.\n" if canceled else "Failed to cancel goal\n")
+            print_text("Goal canceled.\n" if cancel_accepted(event["data"]) else "Failed to cancel goal\n")
             return

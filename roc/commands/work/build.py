@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 import os
+import threading
+from functools import partial
 from pathlib import Path
 
 from roc.cli.options import add_layout_arguments, add_selection_arguments
@@ -30,6 +32,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="compiler jobs of all packages together (default: -j of MAKEFLAGS, else the number of CPUs)")
     add_event_handlers_argument(parser)
     add("--output", choices=("text", "json"), default="text", help="json: one JSON event per line on stdout")
+    add("--tui", action="store_true", help="show the build in roc's terminal user interface: a row per package with "
+        "its state, elapsed time and step; Enter shows a failed package's stderr (see roc tui)")
     add("--allow-overriding", action="extend", nargs="+", default=[], metavar="PKG_NAME",
         help="build these packages without the warning that an underlay workspace has them too")
     add("--force", action="store_true", help="rebuild the selected packages even when they are up to date")
@@ -179,7 +183,37 @@ def _check_supported(args: argparse.Namespace) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from roc.builder.layout import prepare_build_base, prepare_install_base
+    if args.tui and not args.explain:
+        from roc.tui.app import require_terminal
+
+        require_terminal("--tui")
+    workspace, options, switches, remote = _prepare(args)
+    if args.explain:
+        return _explain(args, workspace, options, remote)
+    warn_about_overrides(args, workspace, options.install_base)
+    warn_about_missing_dependencies(workspace)
+    build = partial(_locked_build, args, workspace, options, switches, remote)
+    if args.tui:
+        from roc.tui.app import run_build_app
+
+        return run_build_app(build, verb="build")
+    return build()
+
+
+def build_runner(packages: list[str]):
+    """A build of ``packages`` (every package when empty) of the workspace around the current
+    directory, with the default options: (handlers, stop) -> exit code, for a build started in roc tui."""
+    from roc.cli.commands import build_parser
+
+    args = build_parser(["work", "build"]).parse_args(["work", "build", *packages])
+    args.configuration = None
+    workspace, options, switches, remote = _prepare(args)
+    return partial(_locked_build, args, workspace, options, switches, remote)
+
+
+def _prepare(args: argparse.Namespace):
+    """The workspace, the build options and the output switches of a build, from its arguments."""
+    from roc.engine.jobserver import jobs_from_makeflags
     from roc.workspace.load import load_workspace
 
     _check_supported(args)
@@ -190,9 +224,6 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("--parallel-workers must be 0 (no limit) or more")
     if args.jobs is not None and args.jobs < 1:
         raise UsageError("-j/--jobs must be 1 or more")
-    from roc.builder.lock import build_lock
-    from roc.engine.jobserver import jobs_from_makeflags
-
     workspace = load_workspace(args)
     skip_configured_packages(args, workspace)
     skip_unbuildable_packages(workspace)
@@ -207,23 +238,30 @@ def run(args: argparse.Namespace) -> int:
         use_state=not args.no_cache,
     )
     remote = _remote_cache(args, workspace, options)  # bad settings: a usage error before anything is written
-    if args.explain:
-        return _explain(args, workspace, options, remote)
+    return workspace, options, switches, remote
+
+
+def _locked_build(args, workspace, options, switches: dict[str, bool], remote, extra_handlers: list | None = None,
+                  stop: threading.Event | None = None) -> int:
+    """Build under the build base's lock. ``extra_handlers`` (roc tui's board and summary) replace the
+    console; ``stop`` ends the run as Ctrl+C does."""
+    from roc.builder.layout import prepare_build_base, prepare_install_base
+    from roc.builder.lock import build_lock
+
     compiler = None
     if args.compiler_cache not in (None, "none"):
         from roc.builder.compiler_cache import compiler_cache
 
         compiler = compiler_cache(args.compiler_cache, args.compiler_cache_dir, workspace.root, options.build_base,
                                   remote.settings if remote else None)
-    warn_about_overrides(args, workspace, options.install_base)
-    warn_about_missing_dependencies(workspace)
     with build_lock(options.build_base):
         prepare_build_base(options.build_base)
         prepare_install_base(options.install_base, args.merge_install)
-        return _build(args, workspace, options, switches, remote, compiler)
+        return _build(args, workspace, options, switches, remote, compiler, extra_handlers, stop)
 
 
-def _build(args, workspace, options, switches: dict[str, bool], remote, compiler) -> int:
+def _build(args, workspace, options, switches: dict[str, bool], remote, compiler,
+           extra_handlers: list | None = None, stop: threading.Event | None = None) -> int:
     from roc.builder.layout import refresh_install_scripts
     from roc.builder.plan import plan_build
     from roc.engine.executor import execute
@@ -233,10 +271,11 @@ def _build(args, workspace, options, switches: dict[str, bool], remote, compiler
     workers = 1 if args.executor == "sequential" else args.parallel_workers
     durations = DurationStore(options.build_base / DURATIONS_FILE)
     jobserver = Jobserver(options.jobs)
-    handlers = [*output_handlers(args, switches, workspace.root, options.build_base), durations]
+    handlers = [*output_handlers(args, switches, workspace.root, options.build_base, console=extra_handlers is None),
+                durations, *(extra_handlers or [])]
     try:
         tasks = plan_build(workspace, options, jobserver, durations.durations, remote, compiler)
-        result = execute(tasks, handlers, workers, continue_on_error=args.continue_on_error)
+        result = execute(tasks, handlers, workers, continue_on_error=args.continue_on_error, stop=stop)
     finally:
         jobserver.close()
         statistics = compiler.finish() if compiler is not None else None

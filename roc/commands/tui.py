@@ -1,0 +1,30 @@
+"""roc tui: the terminal user interface for a running ROS 2 system, and for the workspace it runs in
+(its packages, and builds started from it)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--no-workspace", action="store_true",
+                        help="do not show the packages of the workspace around the current directory")
+
+
+def run(args: argparse.Namespace) -> int:
+    from roc.tui.app import RocApp, require_terminal
+
+    require_terminal("roc tui")
+    from roc.commands.work.build import build_runner
+    from roc.tui.packages import WorkspaceView
+    from roc.workspace.root import find_workspace_root
+
+    root = None if args.no_workspace else find_workspace_root(Path.cwd())
+    workspace = WorkspaceView(root) if root is not None and (root / "src").is_dir() else None
+    app = RocApp(workspace=workspace, new_build=build_runner)
+    try:
+        return app.run() or 0
+    finally:
+        if app.build is not None:
+            app.build.finish()

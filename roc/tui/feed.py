@@ -1,0 +1,74 @@
+"""The TUI's one way to the ROS graph: the roc daemon (roc.ros.client), never rclpy in this process.
+
+Queries go through a ``Session``; streams go straight to the daemon's connection, without the
+client's in-process fallback for types the daemon lacks (that fallback imports rclpy): such a topic
+is left out of the rates instead.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable, Iterator
+from typing import Any
+
+from roc.ros.client import DaemonError, Session, start_daemon
+
+
+class Feed:
+    """A lazily started daemon session, shared by every screen (thread-safe: each query and stream
+    has a connection of its own)."""
+
+    def __init__(self) -> None:
+        self._session: Session | None = None
+        self._lock = threading.Lock()
+
+    def session(self) -> Session:
+        with self._lock:
+            if self._session is None:
+                self._session = Session()
+            return self._session
+
+    def query(self, method: str, params: dict[str, Any] | None = None) -> Any:
+        return self.session().query(method, params)
+
+    def snapshot(self) -> dict[str, Any]:
+        """Nodes, topics with their endpoints (for the diagnoses), services, actions."""
+        return self.query("snapshot", {"endpoints": True})
+
+    def stream(self, method: str, params: dict[str, Any], stop: Callable[[], bool]) -> Iterator[dict[str, Any]]:
+        """The events of a daemon stream, heartbeats included, until it ends or ``stop()`` is true
+        (checked at each event: the daemon sends a heartbeat at least every 0.5 s). An error ends it
+        with DaemonError."""
+        self.session()
+        connection = start_daemon()
+        try:
+            for response in connection.stream(method, params):
+                if stop():
+                    return
+                if "error" in response:
+                    raise DaemonError(response["error"]["message"])
+                if response.get("event") is not None:
+                    yield response
+        finally:
+            connection.close()
+
+
+def measure_rates(feed: Feed, topics: list[str], take: Callable[[dict[str, Any]], None],
+                  stop: Callable[[], bool]) -> None:
+    """Feed ``take`` the ``stats`` batches of ``topics`` until ``stop()``. A topic whose type the
+    daemon cannot load ends the request before its ``subscribed`` event (topics are subscribed in
+    order): it is left out, and the others are asked for again."""
+    topics = list(topics)
+    while topics and not stop():
+        subscribed = 0
+        try:
+            for event in feed.stream("stats", {"topics": topics}, stop):
+                if event["event"] == "subscribed":
+                    subscribed += 1
+                elif event["event"] == "batch":
+                    take(event)
+            return
+        except DaemonError:
+            if subscribed >= len(topics):
+                raise
+            del topics[subscribed]

@@ -1,0 +1,142 @@
+"""What ``roc tui`` shows, as plain data: the rows of each list made from the daemon's answers, the
+live rates and bandwidths of topics, the diagnoses, the filter. No Textual here (unit-testable).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from roc.ros.present import is_hidden, problem_line, topic_problems
+from roc.ros.rates import Window, samples, size_text
+
+# Messages kept per topic for the list's rates: enough for a steady rate, little memory for 200 topics
+# (roc topic hz keeps 10000 of one topic; the topic screen does too).
+LIST_WINDOW = 500
+TOPIC_WINDOW = 10000
+NO_PUBLISHER = "no publisher"
+NO_SUBSCRIBER = "no subscriber"
+
+
+@dataclass
+class Row:
+    """One line of a list: its key (the name) and its cells; ``problems`` makes it stand out."""
+
+    key: str
+    cells: tuple[str, ...]
+    problems: list[str] = field(default_factory=list)
+
+
+def matches(needle: str, *texts: str) -> bool:
+    """The filter: every word of ``needle`` appears (any case) in one of ``texts``."""
+    haystack = " ".join(texts).lower()
+    return all(word in haystack for word in needle.lower().split())
+
+
+def shown_endpoints(endpoints: dict[str, Any]) -> dict[str, Any]:
+    """A topic's endpoints less those of hidden nodes (ros2's rule), such as the roc daemon's own
+    subscriptions that measure the rates: they would count as subscribers."""
+    return {side: [e for e in endpoints[side] if not is_hidden(e["node_name"])]
+            for side in ("publishers", "subscribers")}
+
+
+def with_shown_endpoints(topic: dict[str, Any]) -> dict[str, Any]:
+    """A ``snapshot`` topic whose counts leave hidden nodes out (when its endpoints are known)."""
+    if not topic.get("endpoints"):
+        return topic
+    endpoints = shown_endpoints(topic["endpoints"])
+    return {**topic, "endpoints": endpoints, "publishers": len(endpoints["publishers"]),
+            "subscribers": len(endpoints["subscribers"])}
+
+
+def diagnoses(topic: dict[str, Any]) -> list[str]:
+    """What is wrong with a topic of a ``snapshot`` (with endpoints): nobody publishes or nobody
+    listens, and the QoS and type problems ``roc topic info -v`` reports (roc.ros.present)."""
+    found = []
+    if not topic["publishers"]:
+        found.append(NO_PUBLISHER)
+    if not topic["subscribers"]:
+        found.append(NO_SUBSCRIBER)
+    endpoints = topic.get("endpoints")
+    if endpoints:
+        found += [problem_line(p) for p in topic_problems(endpoints)]
+    return found
+
+
+def rate_text(rate: float | None) -> str:
+    return "-" if rate is None else f"{rate:.1f} Hz" if rate < 1000 else f"{rate / 1000:.2f} kHz"
+
+
+def bandwidth_text(bytes_per_second: float | None) -> str:
+    return "-" if bytes_per_second is None else f"{size_text(bytes_per_second)}/s"
+
+
+class Rates:
+    """The rate and bandwidth of each topic, from the ``stats`` stream's batches (as roc topic hz and
+    bw measure them: roc.ros.rates)."""
+
+    def __init__(self, size: int = LIST_WINDOW):
+        self.size = size
+        self.windows: dict[str, Window] = {}
+
+    def add(self, event: dict[str, Any]) -> None:
+        """Take a ``batch`` event."""
+        for topic, columns in event["topics"].items():
+            self.windows.setdefault(topic, Window(self.size)).add(samples(columns))
+
+    def keep(self, topics: set[str]) -> None:
+        """Forget the topics that are gone."""
+        for topic in set(self.windows) - topics:
+            del self.windows[topic]
+
+    def rate(self, topic: str) -> float | None:
+        window = self.windows.get(topic)
+        return window.frequency() if window else None
+
+    def bandwidth(self, topic: str) -> float | None:
+        window = self.windows.get(topic)
+        measured = window.bandwidth() if window else None
+        return measured["bytes_per_second"] if measured else None
+
+
+def visible(entries: list[dict[str, Any]], hidden: bool) -> list[dict[str, Any]]:
+    """Entries without a hidden name (ros2's rule), unless ``hidden``; topics counted without the
+    endpoints of hidden nodes."""
+    shown = entries if hidden else [e for e in entries if not is_hidden(e.get("full_name", e["name"]))]
+    return [with_shown_endpoints(e) if "endpoints" in e and not hidden else e for e in shown]
+
+
+def topic_rows(snapshot: dict[str, Any], rates: Rates, hidden: bool = False) -> list[Row]:
+    return [Row(t["name"], (t["name"], str(t["publishers"]), str(t["subscribers"]), rate_text(rates.rate(t["name"])),
+                            bandwidth_text(rates.bandwidth(t["name"])), ", ".join(t["types"])), diagnoses(t))
+            for t in visible(snapshot["topics"], hidden)]
+
+
+def node_rows(snapshot: dict[str, Any], hidden: bool = False) -> list[Row]:
+    names = [n["full_name"] for n in snapshot["nodes"]]
+    return [Row(n["full_name"], (n["full_name"],), ["duplicate name"] if names.count(n["full_name"]) > 1 else [])
+            for n in visible(snapshot["nodes"], hidden)]
+
+
+def typed_rows(entries: list[dict[str, Any]], hidden: bool = False) -> list[Row]:
+    """Services or actions: name and type."""
+    return [Row(e["name"], (e["name"], ", ".join(e["types"]))) for e in visible(entries, hidden)]
+
+
+def counts(snapshot: dict[str, Any], hidden: bool = False) -> dict[str, int]:
+    """How many of each kind the header shows, and how many topics have a problem."""
+    topics = visible(snapshot["topics"], hidden)
+    return {"nodes": len(visible(snapshot["nodes"], hidden)), "topics": len(topics),
+            "services": len(visible(snapshot["services"], hidden)),
+            "actions": len(visible(snapshot["actions"], hidden)),
+            "problems": sum(1 for t in topics if diagnoses(t))}
+
+
+def endpoint_cells(endpoint: dict[str, Any]) -> tuple[str, ...]:
+    """An endpoint as a row: node, side, reliability, durability, history (depth), deadline."""
+    qos = endpoint["qos"]
+    history = f"KEEP_LAST ({qos['depth']})" if qos["history"] == "KEEP_LAST" else qos["history"]
+    deadline = "-" if qos["deadline_ns"] is None else f"{qos['deadline_ns'] / 1e6:g} ms"
+    who = f"{endpoint['node_namespace'].rstrip('/')}/{endpoint['node_name']}"
+    side = "publisher" if endpoint["endpoint_type"] == "PUBLISHER" else "subscriber"
+    return who, side, qos["reliability"], qos["durability"], history, deadline

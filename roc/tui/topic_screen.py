@@ -1,0 +1,159 @@
+"""A topic: its endpoints with their QoS and the problems between them, its rate and bandwidth (as
+``roc topic hz`` and ``bw`` measure them), and a live echo of its latest message: ``p`` pauses it,
+``f`` shows one field."""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+from rich.text import Text
+from textual import work
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import VerticalScroll
+from textual.screen import Screen
+from textual.widgets import Footer, Static
+from textual.worker import get_current_worker
+
+from roc.errors import RocError
+from roc.ros.rates import Sample, Window
+from roc.tui.model import TOPIC_WINDOW, Row, bandwidth_text, diagnoses, endpoint_cells, rate_text, shown_endpoints
+from roc.tui.widgets import ListTable, Prompt, host
+
+ECHO_SECONDS = 0.25  # the echo pane shows the latest message at most this often
+
+
+def cdr_size(data: str) -> int:
+    """The size of base64 CDR once decoded."""
+    return len(data) * 3 // 4 - data[-2:].count("=")
+
+
+def stats_text(window: Window) -> str:
+    rate, bandwidth = window.rate(), window.bandwidth()
+    if rate is None or bandwidth is None:
+        return "rate: waiting for messages"
+    return (f"rate {rate_text(rate['rate'])} (min {rate['min']:.3f} s, max {rate['max']:.3f} s, std dev "
+            f"{rate['std_dev']:.5f} s, window {rate['window']})  "
+            f"bandwidth {bandwidth_text(bandwidth['bytes_per_second'])}  lost {window.lost}")
+
+
+class TopicScreen(Screen):
+    BINDINGS = [
+        Binding("escape", "app.pop_screen", "back"),
+        Binding("p,space", "pause", "pause/resume echo"),
+        Binding("f", "field", "field"),
+    ]
+    DEFAULT_CSS = """
+    TopicScreen #title { height: 1; background: $primary; }
+    TopicScreen #endpoints { height: auto; max-height: 8; }
+    TopicScreen #problems { height: auto; color: $error; }
+    TopicScreen #stats { height: auto; }
+    TopicScreen #echo-title { height: 1; background: $boost; }
+    TopicScreen VerticalScroll { height: 1fr; }
+    """
+
+    def __init__(self, topic: str) -> None:
+        super().__init__()
+        self.topic = topic
+        self.window = Window(TOPIC_WINDOW)
+        self.type_name: str | None = None
+        self.latest: dict[str, Any] | None = None  # the last message event entry
+        self.count = 0
+        self.shown: dict[str, Any] | None = None  # the message the echo pane shows (kept while paused)
+        self.drawn = -1  # its number
+        self.paused = False
+        self.field = ""
+
+    def compose(self) -> ComposeResult:
+        yield Static(Text(f"topic {self.topic}", style="bold"), id="title")
+        yield ListTable(("node", "side", "reliability", "durability", "history", "deadline"), id="endpoints")
+        yield Static("", id="problems")
+        yield Static("rate: subscribing...", id="stats")
+        yield Static("", id="echo-title")
+        with VerticalScroll():
+            yield Static("", id="echo")
+        yield Footer()
+
+    def on_mount(self) -> None:
+        self.query_one("#endpoints").focus()
+        self.load_endpoints()
+        self.echo()
+        self.set_interval(ECHO_SECONDS, self.draw_echo)
+        self.set_interval(1.0, self.draw_stats)
+        self.set_interval(2.0, self.load_endpoints)
+
+    @work(thread=True, exclusive=True, group="endpoints")
+    def load_endpoints(self) -> None:
+        try:
+            info = host(self).feed.query("topic_endpoints", {"topic": self.topic})
+        except RocError as error:
+            self.app.call_from_thread(self.query_one("#problems", Static).update, str(error))
+            return
+        self.app.call_from_thread(self.show_endpoints, info)
+
+    def show_endpoints(self, info: dict[str, Any]) -> None:
+        info = {**info, **shown_endpoints(info)}
+        rows = [Row(endpoint["gid"], endpoint_cells(endpoint)) for endpoint in info["publishers"] + info["subscribers"]]
+        self.query_one("#endpoints", ListTable).show(rows)
+        problems = diagnoses({**info, "publishers": len(info["publishers"]), "subscribers": len(info["subscribers"]),
+                              "endpoints": info})
+        self.query_one("#problems", Static).update(Text("\n".join(f"! {p}" for p in problems)))
+        self.type_name = self.type_name or (info["types"][0] if info["types"] else None)
+        self.query_one("#title", Static).update(Text(f"topic {self.topic}  {', '.join(info['types'])}", style="bold"))
+
+    @work(thread=True, exclusive=True, group="echo")
+    def echo(self) -> None:
+        worker = get_current_worker()
+        try:
+            for event in host(self).feed.stream("echo", {"topic": self.topic, "wait": 0}, lambda: worker.is_cancelled):
+                if event["event"] == "subscribed":
+                    self.type_name = event["type"]
+                elif event["event"] == "messages":
+                    self.app.call_from_thread(self.take, event["messages"])
+        except RocError as error:
+            self.app.call_from_thread(self.query_one("#stats", Static).update, f"echo: {error}")
+
+    def take(self, messages: list[dict[str, Any]]) -> None:
+        for message in messages:
+            info = message["info"]
+            self.window.add([Sample(info.get("publication_sequence_number"), info.get("source_timestamp"),
+                                    info.get("received_timestamp") or time.time_ns(), cdr_size(message["data"]), None)])
+        self.count += len(messages)
+        self.latest = messages[-1]
+
+    def draw_stats(self) -> None:
+        self.query_one("#stats", Static).update(stats_text(self.window))
+
+    def draw_echo(self, force: bool = False) -> None:
+        state = "paused (p: resume)" if self.paused else "live (p: pause)"
+        field = f", field {self.field}" if self.field else ""
+        self.query_one("#echo-title", Static).update(Text(f"message {self.count}{field}: {state}", style="bold"))
+        if not self.paused and self.latest is not None and self.drawn != self.count:
+            self.shown, self.drawn = self.latest, self.count
+        elif not force:
+            return
+        if self.shown is not None:
+            self.query_one("#echo", Static).update(Text(self.message_text(self.shown["data"])))
+
+    def message_text(self, data: str) -> str:
+        from roc.ros.cdr import decode  # rclpy's serialisation: loaded only for an echo
+        from roc.ros.messages import echo_text, get_field
+
+        try:
+            message = decode(self.type_name or "", data)
+            return echo_text(get_field(message, self.field) if self.field else message, truncate_length=128)
+        except RocError as error:
+            return f"cannot show the message: {error}"
+
+    def action_pause(self) -> None:
+        self.paused = not self.paused
+        self.draw_echo()
+
+    def action_field(self) -> None:
+        def done(text: str | None) -> None:
+            if text is not None:
+                self.field = text.strip()
+                self.draw_echo(force=True)
+        self.app.push_screen(Prompt("field to show, sub-fields separated by '.' (empty: the whole message)",
+                                    self.field), done)

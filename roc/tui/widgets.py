@@ -1,0 +1,185 @@
+"""The TUI's building blocks: a table that follows a changing list (filter, cursor kept on its row),
+a one-line prompt, a text viewer and the help screen."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from typing import Protocol, cast
+
+from rich.text import Text
+from textual.app import ComposeResult
+from textual.binding import Binding, BindingType
+from textual.containers import Vertical
+from textual.screen import ModalScreen
+from textual.widgets import DataTable, Input, Static, TextArea
+from textual.widgets.data_table import ColumnKey
+
+from roc.tui.feed import Feed
+from roc.tui.model import NO_PUBLISHER, NO_SUBSCRIBER, Row, matches
+
+
+class Host(Protocol):
+    """What screens ask of the application (roc.tui.app.RocApp)."""
+
+    feed: Feed
+
+    def open(self, kind: str, name: str) -> None: ...
+
+    def open_package(self, name: str) -> None: ...
+
+    def start_build(self, packages: list[str]) -> None: ...
+
+
+def host(widget) -> Host:
+    return cast(Host, widget.app)
+
+
+WARNINGS = (NO_PUBLISHER, NO_SUBSCRIBER, "duplicate name")
+
+
+def severity(problems: list[str]) -> str:
+    """``error`` (QoS or type problems), ``warning`` (nobody publishes or listens) or ``""``."""
+    if any(p not in WARNINGS for p in problems):
+        return "error"
+    return "warning" if problems else ""
+
+
+STYLES = {"error": "bold red", "warning": "yellow", "": ""}
+MARKS = {"error": "!! ", "warning": "!  ", "": "   "}  # still seen without colour (NO_COLOR)
+
+
+class ListTable(DataTable):
+    """Rows (roc.tui.model.Row) shown as a table: on each ``show`` only changed cells are redrawn, and
+    the cursor stays on the row it was on. ``filter`` keeps the rows whose cells match it. Without
+    colour (NO_COLOR: ANSI mode), the cursor's row is drawn in reverse video."""
+
+    DEFAULT_CSS = """
+    ListTable:ansi > .datatable--cursor { text-style: reverse; }
+    ListTable:ansi > .datatable--header { text-style: bold underline; }
+    """
+
+    def __init__(self, columns: tuple[str, ...], marks: bool = False, widths: dict[str, int] | None = None,
+                 **options) -> None:
+        """``widths``: columns of a fixed width, for values that change all the time (rates): a
+        column sized to its content is measured again, row by row, whenever a cell outgrows it."""
+        super().__init__(cursor_type="row", zebra_stripes=False, **options)
+        self.columns_names = columns
+        self.widths = widths or {}
+        self.marks = marks  # a first column of marks for rows with problems
+        self.filter = ""
+        self.rows_by_key: dict[str, Row] = {}
+        self._all: list[Row] = []
+        self._shown: list[str] = []
+
+    def on_mount(self) -> None:
+        if self.marks:
+            self.add_column("", key="!", width=2)
+        for name in self.columns_names:
+            self.add_column(name, key=name, width=self.widths.get(name))
+
+    def _cells(self, row: Row) -> list:
+        style = STYLES[severity(row.problems)]
+        cells: list = [Text(cell, style=style) for cell in row.cells]  # never Rich markup: "[1, 2]" is a value
+        if self.marks:
+            cells.insert(0, Text(MARKS[severity(row.problems)].strip(), style=style))
+        return cells
+
+    def show(self, rows: Iterable[Row]) -> None:
+        self._all = list(rows)
+        shown = [r for r in self._all if not self.filter or matches(self.filter, *r.cells)]
+        keys = [r.key for r in shown]
+        if keys != self._shown:
+            current = self.selected_key()
+            self.clear()
+            for row in shown:
+                self.add_row(*self._cells(row), key=row.key)
+            if current in keys:
+                self.move_cursor(row=keys.index(current), animate=False)
+        else:
+            columns = (["!"] if self.marks else []) + list(self.columns_names)
+            for row in shown:
+                old = self.rows_by_key.get(row.key)
+                if old == row:
+                    continue
+                for column, value, before in zip(columns, self._cells(row), self._cells(old) if old else []):
+                    if value != before:
+                        width = self.columns[ColumnKey(column)].content_width
+                        grows = column not in self.widths and value.cell_len > width
+                        self.update_cell(row.key, column, value, update_width=grows)
+        self._shown = keys
+        self.rows_by_key = {r.key: r for r in shown}
+
+    def set_filter(self, text: str) -> None:
+        self.filter = text
+        self.show(self._all)
+
+    def selected_key(self) -> str | None:
+        if not self._shown or self.cursor_row < 0 or self.cursor_row >= len(self._shown):
+            return None
+        return self._shown[self.cursor_row]
+
+    def selected(self) -> Row | None:
+        key = self.selected_key()
+        return self.rows_by_key.get(key) if key else None
+
+    @property
+    def shown_count(self) -> int:
+        return len(self._shown)
+
+
+class Prompt(ModalScreen[str | None]):
+    """One line of input; Enter gives it, Esc gives None."""
+
+    BINDINGS = [Binding("escape", "cancel", "cancel")]
+    DEFAULT_CSS = """
+    Prompt { align: center middle; }
+    Prompt > Vertical { width: 72; height: auto; border: round $accent; background: $surface; padding: 0 1; }
+    """
+
+    def __init__(self, title: str, value: str = "") -> None:
+        super().__init__()
+        self.title_text, self.value = title, value
+
+    def compose(self) -> ComposeResult:
+        with Vertical():
+            yield Static(self.title_text)
+            yield Input(self.value, id="prompt")
+
+    def on_input_submitted(self, event: Input.Submitted) -> None:
+        self.dismiss(event.value)
+
+    def action_cancel(self) -> None:
+        self.dismiss(None)
+
+
+class TextViewer(ModalScreen[None]):
+    """A read-only text (a failed package's stderr, the help); Esc or q closes it."""
+
+    BINDINGS = [Binding("escape,q", "close", "close")]
+    DEFAULT_CSS = """
+    TextViewer { align: center middle; }
+    TextViewer > Vertical { width: 100%; height: 100%; border: round $accent; background: $surface; }
+    TextViewer TextArea { height: 1fr; }
+    """
+
+    def __init__(self, title: str, text: str) -> None:
+        super().__init__()
+        self.title_text, self.text = title, text
+
+    def compose(self) -> ComposeResult:
+        with Vertical():
+            yield Static(Text(self.title_text, style="bold"))
+            yield TextArea(self.text, read_only=True, soft_wrap=False, id="viewer")
+
+    def action_close(self) -> None:
+        self.dismiss(None)
+
+
+def binding_lines(title: str, bindings: Iterable[BindingType], display: Callable[[Binding], str]) -> list[str]:
+    """One line per key binding: its keys as ``display`` shows a key (``/``, ``esc``) and what it does."""
+    lines = []
+    for binding in bindings:
+        if isinstance(binding, Binding) and binding.description:
+            keys = ", ".join(display(Binding(key.strip(), binding.action)) for key in binding.key.split(","))
+            lines.append(f"  {keys:<18} {binding.description}")
+    return [title, *lines, ""] if lines else []
