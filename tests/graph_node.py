@@ -3,7 +3,7 @@
     python graph_node.py '{"name": "talker", "namespace": "/", "publishers": [{"topic": "chatter",
         "type": "std_msgs/msg/String", "reliability": "best_effort", "durability": "volatile",
         "depth": 10, "deadline_ms": 0, "values": {"data": "hi"}, "rate_hz": 10}], "subscribers": [{..., "print": true}], "services": [{"name": "reset",
-        "type": "std_srvs/srv/Trigger", "echo": false}], "actions": [{"name": "fibonacci"}], "parameters": {"max_speed": 1.5}}'
+        "type": "std_srvs/srv/Trigger", "echo": false, "introspection": "contents"}], "actions": [{"name": "fibonacci"}], "parameters": {"max_speed": 1.5}}'
 
 Several nodes in one process: pass a JSON list. Prints "ready" once everything is created, then
 spins until killed.
@@ -61,9 +61,11 @@ def make_node(spec: dict) -> Node:
                 print(json.dumps({"topic": topic, "message": repr(msg)}), flush=True)
         node.create_subscription(load(sub["type"]), sub["topic"], received, qos(sub))
     for srv in spec.get("services", []):
-        node.create_service(load(srv["type"]), srv["name"], echo if srv.get("echo") else lambda _req, resp: resp)
+        server = node.create_service(load(srv["type"]), srv["name"],
+                                     echo if srv.get("echo") else lambda _req, resp: resp)
+        introspect(node, server, srv)
     for client in spec.get("clients", []):
-        node.create_client(load(client["type"]), client["name"])
+        introspect(node, node.create_client(load(client["type"]), client["name"]), client)
     for action in spec.get("actions", []):
         from rclpy.action import ActionServer
 
@@ -72,6 +74,16 @@ def make_node(spec: dict) -> Node:
                                         callback_group=ReentrantCallbackGroup(),
                                         cancel_callback=lambda _goal: CancelResponse.ACCEPT)
     return node
+
+
+def introspect(node: Node, endpoint, spec: dict) -> None:
+    """Service introspection as ``spec["introspection"]`` asks: "contents", "metadata" or "off"."""
+    if spec.get("introspection"):
+        from rclpy.qos import qos_profile_system_default
+        from rclpy.service_introspection import ServiceIntrospectionState
+
+        endpoint.configure_introspection(node.get_clock(), qos_profile_system_default,
+                                         getattr(ServiceIntrospectionState, spec["introspection"].upper()))
 
 
 def echo(request, response):

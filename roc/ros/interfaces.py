@@ -7,6 +7,7 @@ from __future__ import annotations
 import os
 import re
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 from roc.environment import path_list
@@ -120,11 +121,18 @@ def nested_type(text: str, package: str) -> str | None:
     return f"{package}/msg/{base}"
 
 
-def show_lines(type_name: str, comments: bool = True, nested_comments: bool = False, level: int = 0) -> list[str]:
-    """The definition of ``type_name`` with every nested message expanded one tab deeper."""
+def installed_definition(type_name: str) -> str:
+    """The text of an installed interface's definition file."""
+    return definition_path(type_name).read_text()
+
+
+def show_lines(type_name: str, comments: bool = True, nested_comments: bool = False, level: int = 0,
+               read: Callable[[str], str] = installed_definition) -> list[str]:
+    """The definition of ``type_name`` (its text from ``read``) with every nested message expanded one
+    tab deeper."""
     package = type_name.split("/")[0]
     lines = []
-    for raw in definition_path(type_name).read_text().splitlines():
+    for raw in read(type_name).splitlines():
         text = raw.rstrip()
         start = _comment_start(text)
         comment = _comment_text(text[start + 1:]) if start >= 0 else ""
@@ -142,5 +150,5 @@ def show_lines(type_name: str, comments: bool = True, nested_comments: bool = Fa
         if text != SEPARATOR and not text.lstrip().startswith("#"):
             nested = nested_type(text, package)
             if nested:
-                lines += show_lines(nested, nested_comments, nested_comments, level + 1)
+                lines += show_lines(nested, nested_comments, nested_comments, level + 1, read)
     return lines
