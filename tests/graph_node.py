@@ -3,7 +3,8 @@
     python graph_node.py '{"name": "talker", "namespace": "/", "publishers": [{"topic": "chatter",
         "type": "std_msgs/msg/String", "reliability": "best_effort", "durability": "volatile",
         "depth": 10, "deadline_ms": 0, "values": {"data": "hi"}, "rate_hz": 10}], "subscribers": [{..., "print": true}], "services": [{"name": "reset",
-        "type": "std_srvs/srv/Trigger", "echo": false, "introspection": "contents"}], "actions": [{"name": "fibonacci"}], "parameters": {"max_speed": 1.5}}'
+        "type": "std_srvs/srv/Trigger", "echo": false, "introspection": "contents"}], "actions": [{"name": "fibonacci"}], "parameters": {"max_speed": 1.5},
+        "lifecycle": {"fail": ["activate"]}}'
 
 Several nodes in one process: pass a JSON list. Prints "ready" once everything is created, then
 spins until killed.
@@ -39,9 +40,36 @@ def qos(spec: dict) -> QoSProfile:
     return profile
 
 
+def lifecycle_node(spec: dict, **options) -> Node:
+    """A managed node (rclpy.lifecycle) whose transitions succeed, except those ``spec["lifecycle"]``
+    names under "fail" (e.g. ["activate"]), which fail."""
+    from rclpy.lifecycle import LifecycleNode, TransitionCallbackReturn
+
+    failing = set(spec["lifecycle"].get("fail", []))
+
+    class Managed(LifecycleNode):
+        def _outcome(self, transition: str) -> TransitionCallbackReturn:
+            return TransitionCallbackReturn.FAILURE if transition in failing else TransitionCallbackReturn.SUCCESS
+
+        def on_configure(self, state):
+            return self._outcome("configure")
+
+        def on_activate(self, state):
+            return self._outcome("activate")
+
+        def on_deactivate(self, state):
+            return self._outcome("deactivate")
+
+        def on_cleanup(self, state):
+            return self._outcome("cleanup")
+
+    return Managed(spec["name"], **options)
+
+
 def make_node(spec: dict) -> Node:
-    node = Node(spec["name"], namespace=spec.get("namespace", "/"),
-                allow_undeclared_parameters=spec.get("undeclared_parameters", False))
+    options = {"namespace": spec.get("namespace", "/"),
+               "allow_undeclared_parameters": spec.get("undeclared_parameters", False)}
+    node = lifecycle_node(spec, **options) if "lifecycle" in spec else Node(spec["name"], **options)
     for name, value in spec.get("parameters", {}).items():
         node.declare_parameter(name, value)
     for pub in spec.get("publishers", []):

@@ -40,6 +40,20 @@ def _resources(kind: str) -> dict[str, Path]:
     return found
 
 
+def resource_prefixes(kind: str) -> dict[str, Path]:
+    """{name: prefix} of the ament index's resources of ``kind`` (e.g. ``packages``,
+    ``rclcpp_components``), the first prefix of AMENT_PREFIX_PATH that registers a name winning."""
+    return _resources(kind)
+
+
+def resource_text(kind: str, name: str) -> str | None:
+    """The content of resource ``name`` of ``kind``, None when no prefix registers it."""
+    prefix = _resources(kind).get(name)
+    if prefix is None:
+        return None
+    return (prefix / "share" / "ament_index" / "resource_index" / kind / name).read_text()
+
+
 def interface_packages() -> list[str]:
     return sorted(_resources("rosidl_interfaces"))
 
