@@ -74,6 +74,11 @@ COMMANDS = (
     (("component", "load"), (), "component.load", "load a component into a container node"),
     (("component", "unload"), (), "component.unload", "unload components from a container node"),
     (("component", "standalone"), (), "component.standalone", "run a component in a container node of its own"),
+    (("doctor",), ("wtf",), "doctor.check", "check the environment, the network and the live graph (like ros2 doctor)"),
+    (("doctor", "hello"), (), "doctor.hello", "check that this host and others hear each other (topic and multicast)"),
+    (("multicast",), (), None, "UDP multicast between hosts: send, receive"),
+    (("multicast", "send"), (), "multicast.send", "send one UDP multicast datagram"),
+    (("multicast", "receive"), (), "multicast.receive", "wait for one UDP multicast datagram"),
     (("interface",), (), None, "ROS interfaces from the ament index: list, packages, package, show"),
     (("interface", "list"), (), "interface.list", "list the messages, services and actions installed"),
     (("interface", "packages"), (), "interface.packages", "list the packages that define interfaces"),
@@ -100,6 +105,9 @@ COMMANDS = (
     (("completion",), (), "completion", "print a shell completion script: bash, zsh or fish"),
 )
 
+
+# Commands with commands below them.
+PARENTS = {path[:-1] for path, _, _, _ in COMMANDS if len(path) > 1}
 
 # Verbs whose options roc.toml and colcon's defaults files can set.
 CONFIGURED_VERBS = ("list", "info", "graph", "build", "test", "env", "cache")
@@ -187,10 +195,10 @@ def build_parser(argv: list[str] | None = None) -> Parser:
     }
     for path, aliases, module, help_text in COMMANDS:
         sub = groups[path[:-1]].add_parser(path[-1], aliases=list(aliases), help=help_text, description=help_text)
-        if module is None:
+        if module is None or path in PARENTS:  # a command may run itself and have commands below it (doctor)
             groups[path] = sub.add_subparsers(dest="_".join(path) + "_command", metavar="COMMAND", parser_class=Parser)
             sub.set_defaults(_group=sub)
-        else:
+        if module is not None:
             if wanted is None or wanted == path:
                 command_module(module).add_arguments(sub)
                 if path[0] == "work" and path[-1] in CONFIGURED_VERBS:
