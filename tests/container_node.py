@@ -19,7 +19,8 @@ from pathlib import Path
 
 import rclpy
 from composition_interfaces.srv import ListNodes, LoadNode, UnloadNode
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from graph_node import serve
+from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from std_msgs.msg import String
@@ -92,11 +93,7 @@ def main() -> None:
     rclpy.init(args=sys.argv)
     executor = MultiThreadedExecutor()
     executor.add_node(Container(executor))
-    print("ready", flush=True)
-    try:
-        executor.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+    serve(executor)
 
 
 if __name__ == "__main__":

@@ -148,6 +148,11 @@ def main() -> None:
     executor = MultiThreadedExecutor()  # an action's execute callback may run while others are served
     for spec in specs if isinstance(specs, list) else [specs]:
         executor.add_node(make_node(spec))
+    serve(executor)
+
+
+def serve(executor) -> None:
+    """Print "ready", then spin until killed (the test nodes' and tests/container_node.py's main loop)."""
     print("ready", flush=True)
     try:
         executor.spin()

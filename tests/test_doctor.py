@@ -7,6 +7,7 @@ tests were written: each side heard the other."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
@@ -17,7 +18,7 @@ from pathlib import Path
 
 import pytest
 from build_helpers import BIN, stop_process
-from graph_helpers import graph_env, read_line, roc, start_nodes, stop_all, stop_daemon
+from graph_helpers import graph_env, read_line, roc, start_nodes, stop_all, stop_daemon, wait_for
 
 from roc.doctor import environment
 from roc.doctor.findings import Finding, summary
@@ -92,12 +93,6 @@ HEALTHY = [{"name": "talker", "publishers": [{"topic": "chatter", "type": "std_m
            {"name": "listener", "subscribers": [{"topic": "chatter", "type": "std_msgs/msg/String"}]}]
 
 
-def wait_for(condition, timeout: float = 20.0) -> None:
-    deadline = time.monotonic() + timeout
-    while not condition():
-        assert time.monotonic() < deadline, "timed out"
-        time.sleep(0.2)
-
 
 @pytest.fixture
 def doctor_env(tmp_path: Path):
@@ -106,12 +101,21 @@ def doctor_env(tmp_path: Path):
     stop_daemon(env)
 
 
+@contextlib.contextmanager
+def running(specs: list, env: dict[str, str], topic: str):
+    """The nodes of ``specs`` in one process, once the daemon has seen ``topic``."""
+    processes = start_nodes([specs], env)
+    try:
+        wait_for(lambda: topic in roc("topic", "list", env=env).stdout.split())
+        yield
+    finally:
+        stop_all(processes)
+
+
 @pytest.mark.slow
 def test_doctor_finds_what_is_wrong_with_a_graph(doctor_env):
     env = doctor_env
-    processes = start_nodes([TROUBLED], env)
-    try:
-        wait_for(lambda: "/cmd" in roc("topic", "list", env=env).stdout.split())
+    with running(TROUBLED, env, "/cmd"):
         text = roc("doctor", env=env)
         assert text.returncode == 1, text.stdout + text.stderr
         assert "  error    node names: 2 nodes are named /talker\n" in text.stdout
@@ -130,16 +134,12 @@ def test_doctor_finds_what_is_wrong_with_a_graph(doctor_env):
         assert "PLATFORM INFORMATION" not in failed and "NETWORK CONFIGURATION" not in failed
         no_daemon = roc("doctor", "--no-daemon", "--format", "json", env=env)
         assert json.loads(no_daemon.stdout)["errors"] == 2
-    finally:
-        stop_all(processes)
 
 
 @pytest.mark.slow
 def test_doctor_passes_a_healthy_graph_and_reports(doctor_env):
     env = doctor_env
-    processes = start_nodes([HEALTHY], env)
-    try:
-        wait_for(lambda: "/chatter" in roc("topic", "list", env=env).stdout.split())
+    with running(HEALTHY, env, "/chatter"):
         healthy = roc("doctor", env=env)
         assert healthy.returncode == 0, healthy.stdout
         assert "graph:\n  ok       node names: 2 node(s), each named once\n" in healthy.stdout
@@ -154,8 +154,6 @@ def test_doctor_passes_a_healthy_graph_and_reports(doctor_env):
         assert "middleware name    : rmw_fastrtps_cpp\n" in report.stdout
         strict = roc("doctor", "--include-warnings", "--no-daemon", env={**env, "ROS_LOCALHOST_ONLY": "1"})
         assert strict.returncode == 1 and "Failed modules: environment" in strict.stdout
-    finally:
-        stop_all(processes)
 
 
 # ---- multicast and hello ---------------------------------------------------------------------------

@@ -11,12 +11,11 @@ import json
 import os
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
 from build_helpers import BIN, stop_process
-from graph_helpers import graph_env, read_line, roc, start_nodes, stop_all, stop_daemon
+from graph_helpers import graph_env, read_line, roc, start_nodes, stop_all, stop_daemon, wait_for
 
 pytestmark = pytest.mark.slow
 
@@ -25,12 +24,6 @@ MANAGED = [{"name": "cam", "lifecycle": {}},
            {"name": "lidar", "namespace": "/robot", "lifecycle": {"fail": ["activate"]}},
            {"name": "_ghost", "lifecycle": {}}, {"name": "plain"}, {"name": "arm", "lifecycle": {}}]
 
-
-def wait_for(condition, timeout: float = 20.0) -> None:
-    deadline = time.monotonic() + timeout
-    while not condition():
-        assert time.monotonic() < deadline, "timed out"
-        time.sleep(0.2)
 
 
 @pytest.fixture(scope="module")
