@@ -8,6 +8,7 @@ import queue
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 
 from build_helpers import BIN, ros_domain_id, stop_process
@@ -74,6 +75,14 @@ def read_line(process: subprocess.Popen, timeout: float = 20.0) -> str | None:
         return lines.get(timeout=max(0.01, timeout))
     except queue.Empty:
         return None
+
+
+def wait_for(condition, timeout: float = 20.0) -> None:
+    """Return once ``condition()`` is true; fail the test when it is not within ``timeout`` seconds."""
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, "timed out waiting for the graph"
+        time.sleep(0.2)
 
 
 def threads(process: subprocess.Popen) -> list[tuple[str, Path]]:

@@ -3,7 +3,8 @@
     python graph_node.py '{"name": "talker", "namespace": "/", "publishers": [{"topic": "chatter",
         "type": "std_msgs/msg/String", "reliability": "best_effort", "durability": "volatile",
         "depth": 10, "deadline_ms": 0, "values": {"data": "hi"}, "rate_hz": 10}], "subscribers": [{..., "print": true}], "services": [{"name": "reset",
-        "type": "std_srvs/srv/Trigger", "echo": false}], "actions": [{"name": "fibonacci"}], "parameters": {"max_speed": 1.5}}'
+        "type": "std_srvs/srv/Trigger", "echo": false, "introspection": "contents"}], "actions": [{"name": "fibonacci"}], "parameters": {"max_speed": 1.5},
+        "lifecycle": {"fail": ["activate"]}}'
 
 Several nodes in one process: pass a JSON list. Prints "ready" once everything is created, then
 spins until killed.
@@ -39,9 +40,36 @@ def qos(spec: dict) -> QoSProfile:
     return profile
 
 
+def lifecycle_node(spec: dict, **options) -> Node:
+    """A managed node (rclpy.lifecycle) whose transitions succeed, except those ``spec["lifecycle"]``
+    names under "fail" (e.g. ["activate"]), which fail."""
+    from rclpy.lifecycle import LifecycleNode, TransitionCallbackReturn
+
+    failing = set(spec["lifecycle"].get("fail", []))
+
+    class Managed(LifecycleNode):
+        def _outcome(self, transition: str) -> TransitionCallbackReturn:
+            return TransitionCallbackReturn.FAILURE if transition in failing else TransitionCallbackReturn.SUCCESS
+
+        def on_configure(self, state):
+            return self._outcome("configure")
+
+        def on_activate(self, state):
+            return self._outcome("activate")
+
+        def on_deactivate(self, state):
+            return self._outcome("deactivate")
+
+        def on_cleanup(self, state):
+            return self._outcome("cleanup")
+
+    return Managed(spec["name"], **options)
+
+
 def make_node(spec: dict) -> Node:
-    node = Node(spec["name"], namespace=spec.get("namespace", "/"),
-                allow_undeclared_parameters=spec.get("undeclared_parameters", False))
+    options = {"namespace": spec.get("namespace", "/"),
+               "allow_undeclared_parameters": spec.get("undeclared_parameters", False)}
+    node = lifecycle_node(spec, **options) if "lifecycle" in spec else Node(spec["name"], **options)
     for name, value in spec.get("parameters", {}).items():
         node.declare_parameter(name, value)
     for pub in spec.get("publishers", []):
@@ -61,9 +89,11 @@ def make_node(spec: dict) -> Node:
                 print(json.dumps({"topic": topic, "message": repr(msg)}), flush=True)
         node.create_subscription(load(sub["type"]), sub["topic"], received, qos(sub))
     for srv in spec.get("services", []):
-        node.create_service(load(srv["type"]), srv["name"], echo if srv.get("echo") else lambda _req, resp: resp)
+        server = node.create_service(load(srv["type"]), srv["name"],
+                                     echo if srv.get("echo") else lambda _req, resp: resp)
+        introspect(node, server, srv)
     for client in spec.get("clients", []):
-        node.create_client(load(client["type"]), client["name"])
+        introspect(node, node.create_client(load(client["type"]), client["name"]), client)
     for action in spec.get("actions", []):
         from rclpy.action import ActionServer
 
@@ -72,6 +102,16 @@ def make_node(spec: dict) -> Node:
                                         callback_group=ReentrantCallbackGroup(),
                                         cancel_callback=lambda _goal: CancelResponse.ACCEPT)
     return node
+
+
+def introspect(node: Node, endpoint, spec: dict) -> None:
+    """Service introspection as ``spec["introspection"]`` asks: "contents", "metadata" or "off"."""
+    if spec.get("introspection"):
+        from rclpy.qos import qos_profile_system_default
+        from rclpy.service_introspection import ServiceIntrospectionState
+
+        endpoint.configure_introspection(node.get_clock(), qos_profile_system_default,
+                                         getattr(ServiceIntrospectionState, spec["introspection"].upper()))
 
 
 def echo(request, response):
@@ -108,6 +148,11 @@ def main() -> None:
     executor = MultiThreadedExecutor()  # an action's execute callback may run while others are served
     for spec in specs if isinstance(specs, list) else [specs]:
         executor.add_node(make_node(spec))
+    serve(executor)
+
+
+def serve(executor) -> None:
+    """Print "ready", then spin until killed (the test nodes' and tests/container_node.py's main loop)."""
     print("ready", flush=True)
     try:
         executor.spin()

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 
 import pytest
-from graph_helpers import graph_env, install_oracle, roc, ros2
+from graph_helpers import graph_env, install_oracle, roc, ros2, stop_daemon
 
 from roc.ros.present import qos_problems, topic_problems
 
@@ -15,7 +15,9 @@ def env(tmp_path_factory):
     reason = install_oracle()
     if reason:
         pytest.skip(f"the ros2 CLI oracle is not available: {reason}")
-    return graph_env(4, tmp_path_factory.mktemp("runtime"))
+    env = graph_env(4, tmp_path_factory.mktemp("runtime"))
+    yield env
+    stop_daemon(env)  # interface show asks the graph (through the daemon) for a type not installed
 
 
 TYPES = ["nav_msgs/msg/Odometry", "geometry_msgs/msg/Twist", "std_srvs/srv/SetBool", "test_msgs/action/Fibonacci",

@@ -46,9 +46,11 @@ COMMANDS = (
     (("node", "info"), (), "node.info", "what a node publishes, subscribes, serves and calls"),
     (("service",), (), None, "ROS services"),
     (("service", "list"), (), "service.list", "list the services of the ROS graph"),
+    (("service", "info"), (), "service.info", "a service's type and its clients and servers (-v: their endpoints)"),
     (("service", "type"), (), "service.type", "print a service's type"),
     (("service", "find"), (), "service.find", "list the services of a given type"),
     (("service", "call"), (), "service.call", "call a service"),
+    (("service", "echo"), (), "service.echo", "print a service's requests and responses (service introspection)"),
     (("action",), (), None, "ROS actions"),
     (("action", "list"), (), "action.list", "list the actions of the ROS graph"),
     (("action", "info"), (), "action.info", "the servers and clients of an action"),
@@ -62,6 +64,22 @@ COMMANDS = (
     (("param", "set"), (), "param.set", "set parameters of a node"),
     (("param", "delete"), (), "param.delete", "delete parameters of a node"),
     (("param", "load"), (), "param.load", "set a node's parameters from a parameter file (as param dump writes it)"),
+    (("lifecycle",), (), None, "managed (lifecycle) nodes"),
+    (("lifecycle", "nodes"), (), "lifecycle.nodes", "list the managed nodes of the ROS graph"),
+    (("lifecycle", "get"), (), "lifecycle.get", "the lifecycle state of one managed node or of every one"),
+    (("lifecycle", "list"), (), "lifecycle.list", "the transitions a managed node can take"),
+    (("lifecycle", "set"), (), "lifecycle.set", "trigger a lifecycle transition of a managed node"),
+    (("component",), (), None, "components and their containers"),
+    (("component", "types"), (), "component.types", "list the component types the ament index registers"),
+    (("component", "list"), (), "component.list", "list the container nodes and their components"),
+    (("component", "load"), (), "component.load", "load a component into a container node"),
+    (("component", "unload"), (), "component.unload", "unload components from a container node"),
+    (("component", "standalone"), (), "component.standalone", "run a component in a container node of its own"),
+    (("doctor",), ("wtf",), "doctor.check", "check the environment, the network and the live graph (like ros2 doctor)"),
+    (("doctor", "hello"), (), "doctor.hello", "check that this host and others hear each other (topic and multicast)"),
+    (("multicast",), (), None, "UDP multicast between hosts"),
+    (("multicast", "send"), (), "multicast.send", "send one UDP multicast datagram"),
+    (("multicast", "receive"), (), "multicast.receive", "wait for one UDP multicast datagram"),
     (("interface",), (), None, "ROS interfaces from the ament index"),
     (("interface", "list"), (), "interface.list", "list the messages, services and actions installed"),
     (("interface", "packages"), (), "interface.packages", "list the packages that define interfaces"),
@@ -96,6 +114,9 @@ COMMANDS = (
     (("completion",), (), "completion", "print a shell completion script: bash, zsh or fish"),
 )
 
+
+# Commands with commands below them.
+PARENTS = {path[:-1] for path, _, _, _ in COMMANDS if len(path) > 1}
 
 # Verbs whose options roc.toml and colcon's defaults files can set.
 CONFIGURED_VERBS = ("list", "info", "graph", "build", "test", "env", "cache")
@@ -199,10 +220,10 @@ def build_parser(argv: list[str] | None = None) -> Parser:
             help_text = f"{help_text}: {', '.join(verbs(path))}"
         sub = groups[path[:-1]].add_parser(path[-1], aliases=list(aliases), help=help_text, description=help_text,
                                            add_help=on_the_way)
-        if module is None:
+        if module is None or path in PARENTS:  # a command may run itself and have commands below it (doctor)
             groups[path] = sub.add_subparsers(dest="_".join(path) + "_command", metavar="COMMAND", parser_class=Parser)
             sub.set_defaults(_group=sub)
-        else:
+        if module is not None:
             if wanted is None or wanted == path:
                 command_module(module).add_arguments(sub)
                 if path[0] == "work" and path[-1] in CONFIGURED_VERBS:

@@ -112,6 +112,16 @@ def rewrite_passthrough(argv: list[str], known_options: set[str]) -> list[str]:
     return result
 
 
+def values_source(args: argparse.Namespace, positional: str) -> tuple[str | None, str]:
+    """The YAML values of a request or goal and where they come from: standard input with ``--stdin``
+    (read to its end, as ros2 does), else the ``positional`` argument."""
+    if getattr(args, "stdin", False):
+        import sys
+
+        return sys.stdin.read(), "standard input"
+    return getattr(args, positional), positional
+
+
 def add_graph_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of every verb that queries the ROS graph."""
     add_format_argument(parser)

@@ -192,14 +192,29 @@ def stop_all_daemons() -> int:
     return sum(stop_daemon(path) for path in sorted(runtime_dir().glob("daemon-*.sock")))
 
 
-def daemon_status() -> dict[str, Any] | None:
-    connection = connect()
+def daemon_status(path: Path | None = None) -> dict[str, Any] | None:
+    """The ``hello`` of this environment's daemon (or the one at ``path``), None when none runs."""
+    connection = connect(path or socket_path())
     if connection is None:
         return None
     try:
         return connection.request("hello", timeout=5)
     finally:
         connection.close()
+
+
+def all_daemon_statuses() -> list[dict[str, Any]]:
+    """The ``hello`` of every roc daemon of this user, whatever its discovery environment (a daemon
+    that does not answer is left out; a dead socket is removed)."""
+    statuses = []
+    for path in sorted(runtime_dir().glob("daemon-*.sock")):
+        try:
+            status = daemon_status(path)
+        except (RocError, OSError, ValueError):
+            continue
+        if status is not None:
+            statuses.append(status)
+    return sorted(statuses, key=lambda status: status.get("started", 0))
 
 
 def query(method: str, params: dict[str, Any] | None = None, *, use_daemon: bool = True,

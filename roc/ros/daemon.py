@@ -13,6 +13,7 @@ import socket
 import sys
 import threading
 import time
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -20,7 +21,21 @@ from roc import __version__
 from roc.errors import RocError
 from roc.ros.protocol import discovery_environment
 
-IDLE_SECONDS = float(os.environ.get("ROC_DAEMON_IDLE_SECONDS", "3600"))
+# An idle daemon exits after this long without a request (a scan of many domains leaves no daemons
+# behind for long); a stream's lines count as requests. ROC_DAEMON_IDLE_SECONDS changes it.
+DEFAULT_IDLE_SECONDS = 300.0
+
+
+def idle_seconds(environment: Mapping[str, str] = os.environ) -> float:
+    """ROC_DAEMON_IDLE_SECONDS, or the default when it is unset or not a positive number."""
+    try:
+        value = float(environment.get("ROC_DAEMON_IDLE_SECONDS") or DEFAULT_IDLE_SECONDS)
+    except ValueError:
+        return DEFAULT_IDLE_SECONDS
+    return value if value > 0 else DEFAULT_IDLE_SECONDS
+
+
+IDLE_SECONDS = idle_seconds()
 
 
 class Daemon:
@@ -106,7 +121,8 @@ class Daemon:
         try:
             if method == "hello":
                 result = {"version": __version__, "pid": os.getpid(), "environment": discovery_environment(),
-                          "started": self.started, "ready": self.ready.is_set(), "socket": str(self.path)}
+                          "started": self.started, "ready": self.ready.is_set(), "socket": str(self.path),
+                          "idle_seconds": IDLE_SECONDS}
             elif method == "shutdown":
                 self.stopping.set()
                 result = {"stopping": True}

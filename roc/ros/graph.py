@@ -28,6 +28,7 @@ from roc.errors import RocError
 from roc.ros.params import WRITES, parameter_value
 from roc.ros.protocol import DEFAULT_SPIN_TIME, PARAMETER_TYPES, full_name
 from roc.ros.raw_subscription import gid_text
+from roc.ros.type_description import describe
 
 # Without a daemon, discovery lasts one Fast DDS announcement period and a margin (3.5 s: measured on
 # localhost, processes keep appearing up to 3 s after a fresh participant starts, with gaps of almost
@@ -73,6 +74,16 @@ def _endpoint(info) -> dict[str, Any]:
             "liveliness_lease_duration_ns": _duration_ns(qos.liveliness_lease_duration),
         },
     }
+
+
+def _service_endpoint(info) -> dict[str, Any]:
+    """An endpoint of a service's request or reply topic, its DDS type name (``std_srvs::srv::dds_::
+    SetBool_Request_``) given as ROS names it (``std_srvs/srv/SetBool_Request``)."""
+    endpoint = _endpoint(info)
+    package, kind, _, name = (endpoint["topic_type"].split("::") + ["", "", "", ""])[:4]
+    if name:
+        endpoint["topic_type"] = f"{package}/{kind}/{name.rstrip('_')}"
+    return endpoint
 
 
 def _names_and_types(pairs) -> list[dict[str, Any]]:
@@ -244,6 +255,22 @@ class Graph:
                         found.append({"node": full_name(namespace, node_name), "types": list(types)})
         return {"name": action, "servers": servers, "clients": clients}
 
+    def service_info(self, service: str) -> dict[str, Any]:
+        """A service's types, client and server counts, and (from the DDS topics the middleware makes
+        of it, ``rq/NAMERequest`` and ``rr/NAMEReply``) the endpoints of its clients and servers."""
+        node = self.node
+        types = dict(node.get_service_names_and_types()).get(service)
+        if types is None:
+            raise NotFound(f"Unknown service '{service}'")
+        request, reply = f"rq{service}Request", f"rr{service}Reply"
+        clients = (node.get_publishers_info_by_topic(request, no_mangle=True)
+                   + node.get_subscriptions_info_by_topic(reply, no_mangle=True))
+        servers = (node.get_subscriptions_info_by_topic(request, no_mangle=True)
+                   + node.get_publishers_info_by_topic(reply, no_mangle=True))
+        return {"name": service, "types": list(types),
+                "clients_count": node.count_clients(service), "services_count": node.count_services(service),
+                "clients": [_service_endpoint(i) for i in clients], "servers": [_service_endpoint(i) for i in servers]}
+
     # -- parameters (service calls to the node) ------------------------------------------------------
     def call_node_service(self, node_name: str, service: str, srv_type, request) -> Any:
         """Call the node's service ``service`` (e.g. ``set_parameters``) and return the response."""
@@ -297,10 +324,14 @@ class Graph:
                               for r in d.integer_range],
         } for d in response.descriptors]
 
-    def param_list(self, node_name: str | None, prefixes: list[str] | None, with_types: bool) -> list[dict]:
-        """[{node, parameters: [{name, type?}]}] for one node or every node."""
-        names = [node_name] if node_name else [n["full_name"] for n in self.snapshot()["nodes"]
-                                               if not n["name"].startswith("_")]
+    def param_list(self, node_name: str | None, prefixes: list[str] | None, with_types: bool,
+                   hidden: bool = False) -> list[dict]:
+        """[{node, parameters: [{name, type?}]}] for one node or every node (``hidden``: hidden nodes too)."""
+        graph = self.snapshot()
+        served = {s["name"] for s in graph["services"]}  # a node without parameter services is left out at once
+        names = [node_name] if node_name else [n["full_name"] for n in graph["nodes"]
+                                               if (hidden or not n["name"].startswith("_"))
+                                               and f"{n['full_name']}/list_parameters" in served]
         result = []
         for name in names:
             try:
@@ -324,10 +355,15 @@ class Graph:
             return self.topic_endpoints(params["topic"])
         if method == "node_info":
             return self.node_info(params["node"])
+        if method == "type_description":
+            return describe(self, params["type"])
+        if method == "service_info":
+            return self.service_info(params["service"])
         if method == "action_info":
             return self.action_info(params["action"])
         if method == "param_list":
-            return self.param_list(params.get("node"), params.get("prefixes"), params.get("types", False))
+            return self.param_list(params.get("node"), params.get("prefixes"), params.get("types", False),
+                                   params.get("hidden", False))
         if method == "param_get":
             names = params["names"]
             return self.param_values(params["node"], names)

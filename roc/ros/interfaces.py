@@ -5,6 +5,8 @@ with nested types expanded as ``ros2 interface show`` prints them. Plain files: 
 from __future__ import annotations
 
 import re
+import sys
+from collections.abc import Callable
 from pathlib import Path
 
 from roc.environment import ament_prefixes
@@ -27,6 +29,20 @@ def _resources(kind: str) -> dict[str, Path]:
                 if not entry.name.startswith("."):
                     found.setdefault(entry.name, prefix)
     return found
+
+
+def resource_prefixes(kind: str) -> dict[str, Path]:
+    """{name: prefix} of the ament index's resources of ``kind`` (e.g. ``packages``,
+    ``rclcpp_components``), the first prefix of AMENT_PREFIX_PATH that registers a name winning."""
+    return _resources(kind)
+
+
+def resource_text(kind: str, name: str) -> str | None:
+    """The content of resource ``name`` of ``kind``, None when no prefix registers it."""
+    prefix = _resources(kind).get(name)
+    if prefix is None:
+        return None
+    return (prefix / "share" / "ament_index" / "resource_index" / kind / name).read_text()
 
 
 def interface_packages() -> list[str]:
@@ -116,11 +132,18 @@ def nested_type(text: str, package: str) -> str | None:
     return f"{package}/msg/{base}"
 
 
-def show_lines(type_name: str, comments: bool = True, nested_comments: bool = False, level: int = 0) -> list[str]:
-    """The definition of ``type_name`` with every nested message expanded one tab deeper."""
+def installed_definition(type_name: str) -> str:
+    """The text of an installed interface's definition file."""
+    return definition_path(type_name).read_text()
+
+
+def show_lines(type_name: str, comments: bool = True, nested_comments: bool = False, level: int = 0,
+               read: Callable[[str], str] = installed_definition) -> list[str]:
+    """The definition of ``type_name`` (its text from ``read``) with every nested message expanded one
+    tab deeper."""
     package = type_name.split("/")[0]
     lines = []
-    for raw in definition_path(type_name).read_text().splitlines():
+    for raw in read(type_name).splitlines():
         text = raw.rstrip()
         start = _comment_start(text)
         comment = _comment_text(text[start + 1:]) if start >= 0 else ""
@@ -138,5 +161,5 @@ def show_lines(type_name: str, comments: bool = True, nested_comments: bool = Fa
         if text != SEPARATOR and not text.lstrip().startswith("#"):
             nested = nested_type(text, package)
             if nested:
-                lines += show_lines(nested, nested_comments, nested_comments, level + 1)
+                lines += show_lines(nested, nested_comments, nested_comments, level + 1, read)
     return lines

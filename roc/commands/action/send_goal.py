@@ -7,7 +7,7 @@ import argparse
 import contextlib
 import signal
 
-from roc.cli.options import add_graph_arguments
+from roc.cli.options import add_graph_arguments, values_source
 from roc.errors import RocError
 from roc.render import print_json_line, print_text
 from roc.ros.client import stream
@@ -18,8 +18,10 @@ from roc.ros.types import action_class
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("action_name", help="name of the action, e.g. /fibonacci")
     parser.add_argument("action_type", help="type of the action, e.g. example_interfaces/action/Fibonacci")
-    parser.add_argument("goal", nargs="?", help="goal field values in YAML, e.g. '{order: 5}' "
+    source = parser.add_mutually_exclusive_group()
+    source.add_argument("goal", nargs="?", help="goal field values in YAML, e.g. '{order: 5}' "
                                                 "(default: the goal's default values)")
+    source.add_argument("--stdin", action="store_true", help="read the goal's values (YAML) from standard input")
     parser.add_argument("-f", "--feedback", action="store_true", help="print the feedback messages")
     add_graph_arguments(parser)
 
@@ -34,7 +36,7 @@ def run(args: argparse.Namespace) -> int:
     from roc.ros.cdr import decode, encode
 
     cls = action_class(args.action_type)
-    request = fill_message(cls.Goal, parse_values(args.goal, "goal"))
+    request = fill_message(cls.Goal, parse_values(*values_source(args, "goal")))
     params = {"action": args.action_name, "type": args.action_type, "goal": encode(request),
               "feedback": args.feedback}
     text = args.format != "json"

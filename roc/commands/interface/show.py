@@ -1,14 +1,17 @@
-"""roc interface show: an interface definition with nested types expanded (like ros2 interface show)."""
+"""roc interface show: an interface definition with nested types expanded (like ros2 interface show); a
+message type that is not installed here is asked of the nodes on the graph that use it (their type
+description service)."""
 
 from __future__ import annotations
 
 import argparse
 import sys
+from typing import Any
 
-from roc.cli.options import add_format_argument
-from roc.errors import UsageError
+from roc.cli.options import add_discovery_arguments, add_format_argument
+from roc.errors import RocError, UsageError
 from roc.render import render
-from roc.ros.interfaces import definition_path, show_lines
+from roc.ros.interfaces import definition_path, installed_definition, show_lines
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -17,6 +20,29 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     comments.add_argument("--no-comments", action="store_true", help="show no comments or blank lines")
     parser.add_argument("type", help="interface type, e.g. std_msgs/msg/String; '-' reads it from stdin")
     add_format_argument(parser)
+    add_discovery_arguments(parser)
+
+
+def _remote(args: argparse.Namespace, type_name: str, missing: RocError) -> dict[str, Any]:
+    """The type's definition from a node on the graph; ``missing`` (the local lookup's error) when the
+    type is no message type or no node describes it."""
+    from roc.ros.client import query
+
+    if type_name.count("/") != 2 or type_name.split("/")[1] != "msg":
+        raise missing
+    try:
+        found = query("type_description", {"type": type_name}, use_daemon=not args.no_daemon,
+                      spin_time=args.spin_time)
+    except RocError:
+        raise missing from None
+    sources = found["sources"]
+
+    def read(name: str) -> str:
+        source = sources.get(name)
+        return source["text"] if source and source["encoding"] == "msg" else installed_definition(name)
+
+    lines = show_lines(type_name, comments=not args.no_comments, nested_comments=args.all_comments, read=read)
+    return {"type": type_name, "file": None, "node": found["node"], "lines": lines}
 
 
 def run(args: argparse.Namespace) -> int:
@@ -25,7 +51,13 @@ def run(args: argparse.Namespace) -> int:
         type_name = sys.stdin.readline().strip()
         if not type_name:
             raise UsageError("no interface type on stdin")
-    lines = show_lines(type_name, comments=not args.no_comments, nested_comments=args.all_comments)
-    render({"type": type_name, "file": str(definition_path(type_name)), "text": "\n".join(lines)},
-           args.format, lines)
+    try:
+        path = definition_path(type_name)
+    except RocError as missing:
+        shown = _remote(args, type_name, missing)
+    else:
+        shown = {"type": type_name, "file": str(path), "lines": show_lines(
+            type_name, comments=not args.no_comments, nested_comments=args.all_comments)}
+    lines = shown.pop("lines")
+    render({**shown, "text": "\n".join(lines)}, args.format, lines)
     return 0

@@ -6,6 +6,7 @@ import argparse
 
 from roc.cli.options import add_graph_arguments
 from roc.commands.graph_query import ask
+from roc.errors import RocError
 from roc.render import render
 
 
@@ -14,11 +15,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--param-prefixes", nargs="+", default=[], metavar="PREFIX",
                         help="only parameters with one of these prefixes")
     parser.add_argument("--param-type", action="store_true", help="print each parameter's type")
+    parser.add_argument("--include-hidden-nodes", action="store_true", help="consider hidden nodes as well")
     add_graph_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:
-    nodes = ask(args, "param_list", {"node": args.node_name, "prefixes": args.param_prefixes, "types": args.param_type})
+    if args.node_name and args.node_name.rsplit("/", 1)[-1].startswith("_") and not args.include_hidden_nodes:
+        raise RocError("Node not found")  # ros2's rule: a node whose own name starts with '_' is hidden
+    nodes = ask(args, "param_list", {"node": args.node_name, "prefixes": args.param_prefixes,
+                                     "types": args.param_type, "hidden": args.include_hidden_nodes})
     lines = []
     for entry in nodes:
         if not args.node_name:

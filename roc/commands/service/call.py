@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from roc.cli.options import add_graph_arguments
+from roc.cli.options import add_graph_arguments, values_source
 from roc.errors import UsageError
 from roc.render import print_json_line, print_text
 from roc.ros.client import stream
@@ -15,8 +15,10 @@ from roc.ros.types import service_class
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("service_name", help="name of the service, e.g. /motor_controller/enable")
     parser.add_argument("service_type", help="type of the service, e.g. std_srvs/srv/SetBool")
-    parser.add_argument("values", nargs="?", help="request field values in YAML, e.g. '{data: true}' "
+    source = parser.add_mutually_exclusive_group()
+    source.add_argument("values", nargs="?", help="request field values in YAML, e.g. '{data: true}' "
                                                   "(default: the request's default values)")
+    source.add_argument("--stdin", action="store_true", help="read the request's values (YAML) from standard input")
     parser.add_argument("-r", "--rate", type=float, metavar="N", help="call N times a second until Ctrl+C "
                                                                     "(default: once)")
     add_graph_arguments(parser)
@@ -28,7 +30,7 @@ def run(args: argparse.Namespace) -> int:
     from roc.ros.cdr import decode, encode
 
     cls = service_class(args.service_type)
-    request = fill_message(cls.Request, parse_values(args.values))
+    request = fill_message(cls.Request, parse_values(*values_source(args, "values")))
     params = {"service": args.service_name, "type": args.service_type, "request": encode(request),
               "rate": args.rate}
     for event in stream("call", params, use_daemon=not args.no_daemon):
