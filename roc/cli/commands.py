@@ -152,7 +152,7 @@ class Parser(argparse.ArgumentParser):
         if isinstance(action, argparse._SubParsersAction) and value not in action.choices:
             hint = did_you_mean(value, action.choices, count=1) or f"choose from {', '.join(action.choices)}"
             raise argparse.ArgumentError(None, f"unknown command '{value}'; {hint}")
-        super()._check_value(action, value)  # type: ignore[misc]
+        super()._check_value(action, value)
 
     def parse_args(self, args=None, namespace=None):
         """Unknown arguments are reported by the parser of the command they were given to."""

@@ -11,8 +11,8 @@ from __future__ import annotations
 import argparse
 import contextlib
 import time
-from collections.abc import Generator, Iterator
-from typing import Any, cast
+from collections.abc import Iterator
+from typing import Any
 
 from roc.errors import RocError
 from roc.ros.client import Session
@@ -54,9 +54,9 @@ def call(opened: Session, service: str, service_type: str, request: Any, timeout
     from roc.ros.types import service_class
 
     params = {"service": service, "type": service_type, "request": encode(request)}
-    response_class = service_class(service_type).Response  # type: ignore[attr-defined]
+    response_class = service_class(service_type).Response
     deadline = time.monotonic() + timeout
-    events = cast(Generator[dict[str, Any], None, None], opened.stream("call", params, heartbeats=True))
+    events = opened.stream("call", params, heartbeats=True)
     try:
         for event in events:
             if event["event"] == "response":

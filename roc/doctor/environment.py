@@ -11,8 +11,8 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from roc.doctor.findings import Finding
-from roc.environment import path_list
-from roc.ros.interfaces import prefixes, resource_prefixes
+from roc.environment import ament_prefixes, path_list
+from roc.ros.interfaces import resource_prefixes
 
 CATEGORY = "environment"
 DEFAULT_RMW = "rmw_fastrtps_cpp"
@@ -169,6 +169,6 @@ def reports(env: Mapping[str, str] = os.environ) -> dict[str, list[tuple[str, st
         "PLATFORM INFORMATION": [("system", platform.system()), ("platform info", platform.platform()),
                                  ("release", platform.release()), ("processor", platform.processor())],
         "ROS 2 INFORMATION": ros,
-        "ROS ENVIRONMENT": variables + [("AMENT_PREFIX_PATH", str(p)) for p in prefixes()],
+        "ROS ENVIRONMENT": variables + [("AMENT_PREFIX_PATH", str(p)) for p in ament_prefixes()],
         "RMW MIDDLEWARE": [("middleware name", env.get("RMW_IMPLEMENTATION") or DEFAULT_RMW)],
     }

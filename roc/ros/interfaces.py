@@ -5,7 +5,6 @@ with nested types expanded as ``ros2 interface show`` prints them. Plain files: 
 from __future__ import annotations
 
 import re
-import sys
 from collections.abc import Callable
 from pathlib import Path
 

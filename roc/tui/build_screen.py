@@ -69,7 +69,7 @@ class BuildScreen(Screen):
         now = time.monotonic()
         self.query_one("#tasks", ListTable).show([board_row(row, now) for row in rows])
         ended = board.ended_at is not None and board.started_at is not None
-        took = board.ended_at - board.started_at if ended else now - self.build.started  # type: ignore[operator]
+        took = board.ended_at - board.started_at if ended else now - self.build.started
         text = progress_text(rows, took, board.finished, board.interrupted)
         if self.build.error:
             text += f"  error: {self.build.error}"

@@ -80,7 +80,7 @@ def _listen(args: argparse.Namespace, me: str, summary: Summary, stop: threading
             if host != me:
                 with summary.lock:
                     summary.subscribed[host] += 1
-    events.close()  # type: ignore[attr-defined]
+    events.close()
 
 
 def _receive(sock: socket.socket, me: str, summary: Summary, stop: threading.Event) -> None:
