@@ -69,6 +69,7 @@ def test_distribution_and_middleware_from_the_ament_index(monkeypatch, tmp_path:
     assert environment.middleware({}).level == "ok"
     assert environment.middleware({"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"}).level == "error"
     monkeypatch.setenv("AMENT_PREFIX_PATH", str(_prefix(tmp_path / "empty")))
+    monkeypatch.setattr("roc.environment.own_prefix", lambda: None)  # no ROS in roc's own environment either
     assert environment.distribution({}).level == "error"
     assert environment.distribution({"ROS_DISTRO": "foxy"}).level == "warning"
 
