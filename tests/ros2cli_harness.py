@@ -26,7 +26,7 @@ from pathlib import Path
 
 import pytest
 from build_helpers import BIN, stop_process
-from graph_helpers import ORACLE_VENV, graph_env, install_oracle, read_line, roc, ros2, stop_daemon
+from graph_helpers import ORACLE_VENV, install_oracle, read_line, roc, ros2, stop_daemon
 
 FIXTURES = Path(__file__).resolve().parent / "ros2cli_fixtures.py"
 TOOLS = ("ros2", "roc")
@@ -107,18 +107,38 @@ class Fixture:
         return len(self.lines)
 
 
-def start_fixture(env: dict[str, str], fixture: str, *arguments: str, name: str | None = None,
-                  namespace: str | None = None, remap: Iterable[tuple[str, str]] = ()) -> Fixture:
-    """A fixture node, as launch_ros's Node(name=..., namespace=..., remappings=...) starts it (a relative
-    namespace is taken from the root); returns once it is created."""
-    namespace = namespace and "/" + namespace.lstrip("/")
-    ros_args = [*(["-r", f"__node:={name}"] if name else []), *(["-r", f"__ns:={namespace}"] if namespace else []),
-                *(a for pair in remap for a in ("-r", f"{pair[0]}:={pair[1]}"))]
-    command = [sys.executable, str(FIXTURES), fixture, *arguments, *(["--ros-args", *ros_args] if ros_args else [])]
-    process = subprocess.Popen(command, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    fixture_process = Fixture(process)
-    assert fixture_process.read_until(["ready"], 0, 30), f"{fixture} did not start: {fixture_process.lines}"
-    return fixture_process
+class FixtureGraph:
+    """Upstream's fixture nodes on the graph of ``env`` (graph_env's, unbuffered as upstream runs every
+    process); leaving it stops them and both CLIs' daemons."""
+
+    def __init__(self, env: dict[str, str]) -> None:
+        self.env = {**env, "PYTHONUNBUFFERED": "1"}
+        self.fixtures: dict[str, Fixture] = {}
+
+    def start(self, fixture: str, *arguments: str, name: str | None = None, namespace: str | None = None,
+              remap: Iterable[tuple[str, str]] = (), key: str | None = None) -> Fixture:
+        """A fixture node (kept as ``key``, default its name or the fixture's), as launch_ros's
+        Node(name=..., namespace=..., remappings=...) starts it (a relative namespace is taken from
+        the root); returns once it is created."""
+        namespace = namespace and "/" + namespace.lstrip("/")
+        ros_args = [*(["-r", f"__node:={name}"] if name else []), *(["-r", f"__ns:={namespace}"] if namespace else []),
+                    *(a for pair in remap for a in ("-r", f"{pair[0]}:={pair[1]}"))]
+        command = [sys.executable, str(FIXTURES), fixture, *arguments, *(["--ros-args", *ros_args] if ros_args else [])]
+        process = subprocess.Popen(command, env=self.env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        started = self.fixtures[key or name or fixture] = Fixture(process)
+        assert started.read_until(["ready"], 0, 30), f"{fixture} did not start: {started.lines}"
+        return started
+
+    def stop(self, key: str) -> None:
+        stop_process(self.fixtures.pop(key).process)
+
+    def __enter__(self) -> FixtureGraph:
+        return self
+
+    def __exit__(self, *_exc) -> None:
+        stop_daemon(self.env)
+        for key in list(self.fixtures):
+            self.stop(key)
 
 
 @dataclass
@@ -202,9 +222,11 @@ class Cli:
         return Result(done.returncode, self.filter(done.stdout))
 
 
-def tool_phase(tool: str, env: dict[str, str], ready: Callable[[Cli], bool], timeout: float = 30.0) -> None:
+def tool_phase(tool: str, env: dict[str, str], ready: Callable[[Cli], bool],
+               output: Callable[[str], str] = lambda text: text, timeout: float = 30.0) -> Cli:
     """Start ``tool``'s phase: the other tool's daemon stopped, this one's started, and ``ready`` true
-    of what it sees (the fixture graph discovered) within ``timeout`` seconds."""
+    of what it sees (the fixture graph discovered) within ``timeout`` seconds; the tool, its output
+    filtered by ``output``."""
     if tool == "ros2":
         stop_daemon(env)  # roc's (and ros2's: restarted, as upstream does)
         ros2("daemon", "start", env=env)
@@ -216,14 +238,4 @@ def tool_phase(tool: str, env: dict[str, str], ready: Callable[[Cli], bool], tim
     while not ready(cli):
         assert time.monotonic() < deadline, f"{tool} did not discover the fixture graph within {timeout:g} s"
         time.sleep(0.5)
-
-
-def fixture_env(slot: int, runtime_dir: Path) -> dict[str, str]:
-    """graph_env, unbuffered as upstream runs every process."""
-    return graph_env(slot, runtime_dir, PYTHONUNBUFFERED="1")
-
-
-def stop_fixtures(env: dict[str, str], fixtures: Iterable[Fixture]) -> None:
-    stop_daemon(env)
-    for fixture in fixtures:
-        stop_process(fixture.process)
+    return Cli(tool, env, output)

@@ -9,18 +9,8 @@ import re
 
 import pytest
 import yaml
-from build_helpers import stop_process
-from ros2cli_harness import (
-    TOOLS,
-    Cli,
-    expect_lines,
-    fixture_env,
-    oracle,
-    retry,
-    start_fixture,
-    stop_fixtures,
-    tool_phase,
-)
+from graph_helpers import graph_env
+from ros2cli_harness import TOOLS, Cli, FixtureGraph, expect_lines, oracle, retry, tool_phase
 
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("ros2cli_action_param")]
 __all__ = ["oracle"]
@@ -70,10 +60,9 @@ INPUT_NODE_OVERLAY_PARAMETER_FILE = "/foo/test_node:\n  ros__parameters:\n    st
 
 @pytest.fixture(scope="module")
 def graph(tmp_path_factory, oracle):  # noqa: F811
-    env = fixture_env(23, tmp_path_factory.mktemp("runtime"))
-    server = start_fixture(env, "fibonacci_action_server")
-    yield env
-    stop_fixtures(env, [server])
+    with FixtureGraph(graph_env(23, tmp_path_factory.mktemp("runtime"))) as graph:
+        graph.start("fibonacci_action_server")
+        yield graph
 
 
 def _discovered(cli: Cli) -> bool:
@@ -86,10 +75,9 @@ def _discovered(cli: Cli) -> bool:
 
 @pytest.fixture(scope="module", params=TOOLS)
 def cli(request, graph) -> Cli:
-    parameter_node = start_fixture(graph, "parameter_node", name="test_node", namespace="/foo")
-    tool_phase(request.param, graph, _discovered)
-    yield Cli(request.param, graph)
-    stop_process(parameter_node.process)
+    graph.start("parameter_node", name="test_node", namespace="/foo")
+    yield tool_phase(request.param, graph.env, _discovered)
+    graph.stop("test_node")
 
 
 # -- ros2action ---------------------------------------------------------------------------------------

@@ -6,18 +6,8 @@ from __future__ import annotations
 import re
 
 import pytest
-from ros2cli_harness import (
-    TOOLS,
-    Cli,
-    expect_lines,
-    fixture_env,
-    oracle,
-    output_filter,
-    retry,
-    start_fixture,
-    stop_fixtures,
-    tool_phase,
-)
+from graph_helpers import graph_env
+from ros2cli_harness import TOOLS, Cli, FixtureGraph, expect_lines, oracle, output_filter, retry, tool_phase
 
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("ros2cli_node")]
 __all__ = ["oracle"]
@@ -29,11 +19,10 @@ NODE_FILTER = output_filter(patterns=[".*launch_ros.*", ".*ros2cli.*"])
 @pytest.fixture(scope="module")
 def graph(tmp_path_factory, oracle):  # noqa: F811
     """complex_node, and the same node hidden (_hidden_complex_node)."""
-    env = fixture_env(21, tmp_path_factory.mktemp("runtime"))
-    fixtures = [start_fixture(env, "complex_node", name="complex_node"),
-                start_fixture(env, "complex_node", name="_hidden_complex_node")]
-    yield env
-    stop_fixtures(env, fixtures)
+    with FixtureGraph(graph_env(21, tmp_path_factory.mktemp("runtime"))) as graph:
+        graph.start("complex_node", name="complex_node")
+        graph.start("complex_node", name="_hidden_complex_node")
+        yield graph
 
 
 def _discovered(cli: Cli) -> bool:
@@ -45,8 +34,7 @@ def _discovered(cli: Cli) -> bool:
 
 @pytest.fixture(scope="module", params=TOOLS)
 def cli(request, graph) -> Cli:
-    tool_phase(request.param, graph, _discovered)
-    return Cli(request.param, graph, NODE_FILTER)
+    return tool_phase(request.param, graph.env, _discovered, NODE_FILTER)
 
 
 @retry(5)

@@ -4,18 +4,8 @@ the real ros2 on the upstream fixture graph (tests/ros2cli_harness.py says how).
 from __future__ import annotations
 
 import pytest
-from ros2cli_harness import (
-    TOOLS,
-    Cli,
-    expect_lines,
-    fixture_env,
-    oracle,
-    output_filter,
-    retry,
-    start_fixture,
-    stop_fixtures,
-    tool_phase,
-)
+from graph_helpers import graph_env
+from ros2cli_harness import TOOLS, Cli, FixtureGraph, expect_lines, oracle, output_filter, retry, tool_phase
 
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("ros2cli_service")]
 __all__ = ["oracle"]
@@ -49,12 +39,10 @@ def echo_call_output(**fields) -> list[str]:
 @pytest.fixture(scope="module")
 def graph(tmp_path_factory, oracle):  # noqa: F811
     """/my_ns/echo_server, and the same server hidden (/my_ns/_hidden_echo_server serving _echo)."""
-    env = fixture_env(22, tmp_path_factory.mktemp("runtime"))
-    fixtures = [start_fixture(env, "echo_server", name="echo_server", namespace="my_ns"),
-                start_fixture(env, "echo_server", name="_hidden_echo_server", namespace="my_ns",
-                              remap=[("echo", "_echo")])]
-    yield env
-    stop_fixtures(env, fixtures)
+    with FixtureGraph(graph_env(22, tmp_path_factory.mktemp("runtime"))) as graph:
+        graph.start("echo_server", name="echo_server", namespace="my_ns")
+        graph.start("echo_server", name="_hidden_echo_server", namespace="my_ns", remap=[("echo", "_echo")])
+        yield graph
 
 
 def _discovered(cli: Cli) -> bool:
@@ -65,8 +53,7 @@ def _discovered(cli: Cli) -> bool:
 
 @pytest.fixture(scope="module", params=TOOLS)
 def cli(request, graph) -> Cli:
-    tool_phase(request.param, graph, _discovered)
-    return Cli(request.param, graph, SERVICE_FILTER)
+    return tool_phase(request.param, graph.env, _discovered, SERVICE_FILTER)
 
 
 @retry(5)

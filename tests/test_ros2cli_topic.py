@@ -8,20 +8,9 @@ import math
 import re
 
 import pytest
-from build_helpers import BIN, stop_process
-from ros2cli_harness import (
-    TOOLS,
-    Cli,
-    Stream,
-    expect_lines,
-    fixture_env,
-    oracle,
-    output_filter,
-    retry,
-    start_fixture,
-    stop_fixtures,
-    tool_phase,
-)
+from build_helpers import BIN
+from graph_helpers import graph_env
+from ros2cli_harness import TOOLS, Cli, FixtureGraph, Stream, expect_lines, oracle, output_filter, retry, tool_phase
 
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("ros2cli_topic")]
 __all__ = ["oracle"]
@@ -35,19 +24,17 @@ STATS_LINE = re.compile(r"\s*min: \d+.\d{3}s max: \d+.\d{3}s std dev: \d+.\d{5}s
 @pytest.fixture(scope="module")
 def graph(tmp_path_factory, oracle):  # noqa: F811
     """talker and listener (on chit_chatter), a hidden talker, four repeaters and the controller."""
-    env = fixture_env(20, tmp_path_factory.mktemp("runtime"))
-    fixtures = {"talker": start_fixture(env, "talker"),
-                "listener": start_fixture(env, "listener", remap=[("chatter", "chit_chatter")]),
-                "hidden_talker": start_fixture(env, "talker", remap=[("chatter", "_hidden_chatter")])}
-    for type_name, name, topic in (("Arrays", "array_repeater", "/arrays"),
-                                   ("Defaults", "defaults_repeater", "/defaults"),
-                                   ("BoundedSequences", "bounded_sequences_repeater", "/bounded_sequences"),
-                                   ("UnboundedSequences", "unbounded_sequences_repeater", "/unbounded_sequences")):
-        fixtures[name] = start_fixture(env, "repeater", f"test_msgs/msg/{type_name}", name=name,
-                                       remap=[(f"/{name}/output", topic)])
-    fixtures["controller"] = start_fixture(env, "controller")
-    yield env, fixtures
-    stop_fixtures(env, fixtures.values())
+    with FixtureGraph(graph_env(20, tmp_path_factory.mktemp("runtime"))) as graph:
+        graph.start("talker")
+        graph.start("listener", remap=[("chatter", "chit_chatter")])
+        graph.start("talker", remap=[("chatter", "_hidden_chatter")], key="hidden_talker")
+        for type_name, name, topic in (("Arrays", "array_repeater", "/arrays"),
+                                       ("Defaults", "defaults_repeater", "/defaults"),
+                                       ("BoundedSequences", "bounded_sequences_repeater", "/bounded_sequences"),
+                                       ("UnboundedSequences", "unbounded_sequences_repeater", "/unbounded_sequences")):
+            graph.start("repeater", f"test_msgs/msg/{type_name}", name=name, remap=[(f"/{name}/output", topic)])
+        graph.start("controller")
+        yield graph
 
 
 NODES = ["/talker_node", "/talker_node", "/listener", "/array_repeater", "/defaults_repeater",
@@ -64,9 +51,7 @@ def _discovered(cli: Cli) -> bool:
 
 @pytest.fixture(scope="module", params=TOOLS)
 def cli(request, graph) -> Cli:
-    env, _ = graph
-    tool_phase(request.param, env, _discovered)
-    return Cli(request.param, env, ECHO_FILTER)
+    return tool_phase(request.param, graph.env, _discovered, ECHO_FILTER)
 
 
 def own_nodes(cli: Cli) -> int:
@@ -288,7 +273,7 @@ PUB_QOS = ["--keep-alive", "3", "--qos-durability", "transient_local", "--qos-re
 
 
 def test_topic_pub(cli, graph):
-    listener = graph[1]["listener"]
+    listener = graph.fixtures["listener"]
     since = listener.mark()
     with cli.stream("topic", "pub", *PUB_QOS, "/chit_chatter", "std_msgs/msg/String", "{data: foo}") as command:
         assert command.wait_for_output(["publisher: beginning loop", "publishing #1: std_msgs.msg.String(data='foo')",
@@ -298,7 +283,7 @@ def test_topic_pub(cli, graph):
 
 
 def test_topic_pub_once(cli, graph):
-    listener = graph[1]["listener"]
+    listener = graph.fixtures["listener"]
     since = listener.mark()
     with cli.stream("topic", "pub", "--once", *PUB_QOS, "/chit_chatter", "std_msgs/msg/String",
                     "{data: bar}") as command:
@@ -310,10 +295,9 @@ def test_topic_pub_once(cli, graph):
 
 
 def test_topic_pub_once_matching_two_listeners(cli, graph):
-    env, fixtures = graph
-    listener = fixtures["listener"]
+    listener = graph.fixtures["listener"]
     since = listener.mark()
-    second = start_fixture(env, "listener", name="second_listener", remap=[("chatter", "chit_chatter")])
+    second = graph.start("listener", name="second_listener", remap=[("chatter", "chit_chatter")])
     try:
         with cli.stream("topic", "pub", "--once", "--keep-alive", "3", "-w", "2", "--qos-durability", "transient_local",
                         "--qos-reliability", "reliable", "/chit_chatter", "std_msgs/msg/String",
@@ -326,11 +310,11 @@ def test_topic_pub_once_matching_two_listeners(cli, graph):
             assert _heard(second, 0, "bar")
         assert command.exit_code == 0
     finally:
-        stop_process(second.process)
+        graph.stop("second_listener")
 
 
 def test_topic_pub_print_every_two(cli, graph):
-    listener = graph[1]["listener"]
+    listener = graph.fixtures["listener"]
     since = listener.mark()
     with cli.stream("topic", "pub", "-p", "2", *PUB_QOS, "/chit_chatter", "std_msgs/msg/String",
                     "{data: fizz}") as command:
@@ -385,8 +369,7 @@ def test_topic_bw(cli):
 def test_roc_lists_and_counts_none_of_its_own_participants(graph, flags):
     """Not its daemon's node, nor the subscription a `roc topic echo` has in it, nor a daemon-less
     participant: in node, service and topic listings and counts, with and without the daemon."""
-    env, _ = graph
-    roc = Cli("roc", env)
+    roc = Cli("roc", graph.env)
     with roc.stream("topic", "echo", "/chatter") as echo:  # its subscription lives in roc's daemon
         assert echo.wait_for_output([re.compile(r"data: 'Hello World: \d+'")], timeout=20), echo.output
         nodes = [line for line in roc.run("node", "list", "-a", *flags, timeout=20).output.splitlines()
@@ -404,9 +387,8 @@ def test_roc_lists_and_counts_none_of_its_own_participants(graph, flags):
 def test_roc_hz_filter_counts_only_what_passes_and_loses_nothing(graph):
     """The rate of the messages that pass (every second one of a 1 Hz topic: 0.5), and no "message(s)
     lost" for those the filter left out."""
-    env, _ = graph
     command = Stream([str(BIN / "roc"), "topic", "hz", "--filter", 'int(m.data.rpartition(":")[-1]) % 2 == 0',
-                      "/chatter"], env, lambda text: text)
+                      "/chatter"], graph.env, lambda text: text)
     try:
         assert command.wait_for_output([re.compile(r"average rate: 0\.500"), STATS_LINE] * 2, timeout=20), \
             command.output
