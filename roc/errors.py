@@ -9,9 +9,15 @@ EXIT_INTERRUPTED = 130
 
 
 class RocError(Exception):
-    """A failure the user can act on; the message says what and where."""
+    """A failure the user can act on; the message says what and where. ``ros2_line``: the line the ros2
+    CLI prints for the same failure, where roc's message says more than it; printed first, then roc's
+    ``roc: error: ...`` line (ros2's own words stay where a user or a script looks for them)."""
 
     exit_code = EXIT_FAILURE
+
+    def __init__(self, message: str = "", *, ros2_line: str | None = None) -> None:
+        super().__init__(message)
+        self.ros2_line = ros2_line
 
 
 class UsageError(RocError):

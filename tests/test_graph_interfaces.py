@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 from graph_helpers import graph_env, install_oracle, roc, ros2, stop_daemon
@@ -62,10 +63,14 @@ def test_proto_same_as_ros2(env, type_name, options):
     assert got.stdout == expected.stdout
 
 
-def test_unknown_interface_is_one_line(env):
+def test_unknown_interface_says_ros2s_line_then_roc_s(env):
+    got = roc("interface", "show", "std_msgs/msg/Strin", env=env)
+    ros2_line, roc_line = got.stderr.splitlines()
+    assert got.returncode == 1 and re.fullmatch(r"Could not find the interface '.+/std_msgs/msg/Strin\.idl'", ros2_line)
+    assert roc_line == "roc: error: std_msgs has no msg named 'Strin'; did you mean 'String'?"
     got = roc("interface", "show", "std_msgs/msg/Nope", env=env)
-    assert got.returncode == 1 and got.stderr.startswith("roc: error: Could not find the interface ")
-    assert len(got.stderr.splitlines()) == 1
+    assert got.stderr.splitlines()[1] == ("roc: error: std_msgs has no msg named 'Nope'; 'roc interface package "
+                                          "std_msgs' lists its interfaces")
     assert roc("interface", "package", "nope", env=env).stderr == "roc: error: Unknown package 'nope'\n"
     proto = roc("interface", "proto", "nope/msg/X", env=env)
     assert proto.returncode == 1 and len(proto.stderr.splitlines()) == 1

@@ -203,12 +203,17 @@ def test_echo_field_selects_like_ros2() -> None:
     with pytest.raises(MessageValueError) as error:
         get_field(odom, "pose.q")
     assert str(error.value) == "pose.q: geometry_msgs/msg/PoseWithCovariance has no field 'q' (pose, covariance)"
+    assert error.value.ros2_line == "Invalid field 'pose.q': 'PoseWithCovariance' object has no attribute 'q'"
     with pytest.raises(MessageValueError) as error:
         get_field(odom, "child_frame_id.x")
     assert str(error.value) == "child_frame_id.x: 'child_frame_id' is not a message"
+    assert error.value.ros2_line == "Invalid field 'child_frame_id.x': 'str' object has no attribute 'x'"
     with pytest.raises(MessageValueError) as error:
         get_field(fill_message("std_msgs/msg/Empty", {}), "x")
     assert str(error.value) == "x: std_msgs/msg/Empty has no field 'x' (it has no fields)"
+    with pytest.raises(MessageValueError) as error:
+        get_field(odom, ".")
+    assert error.value.ros2_line == "Invalid field value '.'"
 
 
 def test_flow_style_and_csv() -> None:

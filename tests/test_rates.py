@@ -57,8 +57,12 @@ def test_bandwidth_and_delay() -> None:
     window = Window(10)
     window.add([_sample(n, n * 100, size=size, stamp_ms=n * 100 - 2) for n, size in ((1, 100), (2, 300), (3, 200))])
     bandwidth = window.bandwidth()
-    assert bandwidth == {"bytes_per_second": pytest.approx(600 / 0.2), "messages": 3, "mean": 200, "min": 100,
+    # the bytes that came after the first message over the 0.2 s since it came (3 messages, 2 intervals)
+    assert bandwidth == {"bytes_per_second": pytest.approx(500 / 0.2), "messages": 3, "mean": 200, "min": 100,
                          "max": 300}
+    steady = Window(10)  # ros2's test: a 52-byte message at 1 Hz is 52 B/s from the second message on
+    steady.add([_sample(1, 0, size=52), _sample(2, 1000, size=52)])
+    assert size_text(steady.bandwidth()["bytes_per_second"]) == "52 B"
     delay = window.delay()
     assert (delay["delay"], delay["min"], delay["max"], delay["window"]) == (
         pytest.approx(0.002), pytest.approx(0.002), pytest.approx(0.002), 3)

@@ -149,7 +149,7 @@ def test_help(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("argv, message", [
     (["nosuchcommand"], "roc: error: unknown command 'nosuchcommand'; choose from work, w, topic"),
-    (["work", "list", "--bogus"], "roc: error: unrecognized arguments: --bogus"),
+    (["work", "list", "--bogus"], "roc work list: error: unrecognized arguments: --bogus"),
     (["work", "list", "-n", "-p"], "not allowed with argument"),
     (["work", "graph", "--format", "yaml"], "invalid choice: 'yaml'"),
     (["completion", "tcsh"], "invalid choice: 'tcsh'"),

@@ -7,6 +7,8 @@ import argparse
 import io
 from pathlib import Path
 
+from build_helpers import copy_fixture, roc
+
 from roc.cli.options import add_selection_arguments
 from roc.engine.events import (
     RunFinished,
@@ -119,11 +121,26 @@ def test_selection_by_the_last_test_result(tmp_path: Path) -> None:
         (tmp_path / name).mkdir()
         (tmp_path / name / "colcon_test.rc").write_text(text)
     parser = argparse.ArgumentParser()
-    add_selection_arguments(parser, previous_test=True)
+    add_selection_arguments(parser)
     failures = parser.parse_args(["--packages-select-test-failures"])
     assert select_packages(failures, packages, tmp_path) == {"failed"}
     not_passed = parser.parse_args(["--packages-skip-test-passed"])
     assert select_packages(not_passed, packages, tmp_path) == {"failed", "aborted", "untested"}
+
+
+def test_build_and_list_select_by_the_last_test_result_as_colcon(tmp_path: Path) -> None:
+    """colcon-test-result gives every verb these options (they used to be refused with "roc has no test
+    verb yet")."""
+    workspace = copy_fixture("selection", tmp_path / "ws")
+    for name, text in (("core", "test failures\n"), ("tool", "0\n")):
+        (workspace / "build" / name).mkdir(parents=True)
+        (workspace / "build" / name / "colcon_test.rc").write_text(text)
+    failures = roc("work", "list", "-n", "--packages-select-test-failures", cwd=workspace)
+    assert (failures.returncode, failures.stdout, failures.stderr) == (0, "core\n", "")
+    not_passed = roc("work", "list", "-n", "--packages-skip-test-passed", cwd=workspace)
+    assert not_passed.returncode == 0 and "tool" not in not_passed.stdout.split() and "core" in not_passed.stdout
+    explained = roc("work", "build", "--packages-select-test-failures", "--explain", cwd=workspace)
+    assert (explained.returncode, explained.stdout) == (0, "core: never built\n"), explained.stderr
 
 
 def test_console_names_the_runs_own_kind_as_colcon_and_other_kinds_by_key() -> None:

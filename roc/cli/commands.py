@@ -126,14 +126,12 @@ CONFIGURED_VERBS = ("list", "info", "graph", "build", "test", "env", "cache")
 COLCON_ONLY_OPTIONS = {
     "--mixin": "colcon-mixin; put the arguments in a [profile.NAME] of roc.toml and use --profile NAME",
     "--mixin-files": "colcon-mixin; put the arguments in a [profile.NAME] of roc.toml and use --profile NAME",
-    "--packages-select-test-failures": "colcon-test-result; roc has it only for roc work test",
-    "--packages-skip-test-passed": "colcon-test-result; roc has it only for roc work test",
     "--log-level": "colcon's logging; use --debug for tracebacks and the log/ directory for build logs",
 }
 
 
 class Parser(argparse.ArgumentParser):
-    """argparse with roc's one-line usage errors (``roc: error: ... (see 'roc work build --help')``) and
+    """argparse with roc's one-line usage errors (``roc work build: error: ... (see 'roc work build --help')``) and
     no abbreviated options (``--symlink-instal`` is an error, not ``--symlink-install``); ``leaves``
     maps each command path to its parser."""
 
@@ -144,7 +142,8 @@ class Parser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
 
     def error(self, message: str):
-        self.exit(EXIT_USAGE, f"roc: error: {message} (see '{self.prog} --help')\n")
+        """argparse's (and ros2's and colcon's) ``PROG: error: MESSAGE``, one line, with where to look."""
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
 
     def _check_value(self, action: argparse.Action, value) -> None:
         """A command or verb that does not exist gets the hint a mistyped option gets (the closest

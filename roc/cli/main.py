@@ -1,6 +1,7 @@
 """The ``roc`` command: argument parsing, dispatch and the error convention.
 
-Exit codes: 0 ok, 1 failure, 2 usage error, 130 interrupted. Errors are one line on stderr; a Python
+Exit codes: 0 ok, 1 failure, 2 usage error, 130 interrupted. Errors are one line on stderr (after the
+ros2 CLI's own line for the same error, where roc says more than it: RocError.ros2_line); a Python
 traceback only with ``--debug`` or ``ROC_DEBUG=1``. Command modules are imported only when run, so
 that start-up stays light.
 """
@@ -101,6 +102,8 @@ def main(argv: list[str] | None = None) -> int:
     except RocError as error:
         if debug:
             raise
+        if error.ros2_line:
+            print(error.ros2_line, file=sys.stderr)
         print(f"roc: error: {_with_help_pointer(error, path)}", file=sys.stderr)
         return error.exit_code
     except KeyboardInterrupt:

@@ -14,9 +14,10 @@ def add_format_argument(parser: argparse.ArgumentParser, formats: tuple[str, ...
                         help="output format (default: text); json is stable for scripts")
 
 
-def add_selection_arguments(parser: argparse.ArgumentParser, previous_test: bool = False) -> None:
-    """Discovery and selection options, as in colcon (``--packages-start``/``-end`` spelled as colcon 0.21);
-    ``previous_test`` adds the options that select by the last test result (roc work test)."""
+def add_selection_arguments(parser: argparse.ArgumentParser) -> None:
+    """Discovery and selection options, as in colcon (``--packages-start``/``-end`` spelled as colcon 0.21),
+    on every verb that selects packages: the ones that select by the last build or test result too
+    (colcon-test-result adds them to every verb, as ``build --packages-select-test-failures``)."""
     discovery = parser.add_argument_group("discovery")
     discovery.add_argument("--base-paths", nargs="*", metavar="PATH",
                            help="base paths to crawl recursively for packages (default: the workspace root)")
@@ -47,11 +48,10 @@ def add_selection_arguments(parser: argparse.ArgumentParser, previous_test: bool
                           help="only packages whose last build failed (aborted ones are not failures)")
     previous.add_argument("--packages-skip-build-finished", action="store_true",
                           help="skip packages whose last build finished successfully")
-    if previous_test:
-        previous.add_argument("--packages-select-test-failures", action="store_true",
-                              help="only packages whose last test run had failures or errors")
-        previous.add_argument("--packages-skip-test-passed", action="store_true",
-                              help="skip packages whose last test run passed")
+    previous.add_argument("--packages-select-test-failures", action="store_true",
+                          help="only packages whose last test run had failures or errors")
+    previous.add_argument("--packages-skip-test-passed", action="store_true",
+                          help="skip packages whose last test run passed")
     add("--packages-select", nargs="*", metavar="PKG_NAME", help="only these packages")
     add("--packages-skip", nargs="*", metavar="PKG_NAME", help="skip these packages")
     add("--packages-select-regex", nargs="*", metavar="PATTERN", help="only packages whose name matches a pattern")

@@ -95,10 +95,23 @@ def run_find(args: argparse.Namespace, kind: str, type_name: str) -> int:
     return 0
 
 
+def add_type_arguments(parser: argparse.ArgumentParser, noun: str, plural: str, example: str,
+                       hidden: bool = True) -> None:
+    """``NAME`` and (``hidden``) ``--include-hidden-PLURAL``, as ros2's ``NOUN type``."""
+    parser.add_argument(f"{noun}_name", help=f"name of the {noun}, e.g. {example}")
+    if hidden:
+        add_hidden_argument(parser, plural)
+    add_graph_arguments(parser)
+
+
 def run_type(args: argparse.Namespace, kind: str, noun: str, name: str) -> int:
-    """``topic|service|action type NAME``: its types, one a line; ros2's "Unknown NOUN 'NAME'" if none."""
-    types = next((e["types"] for e in snapshot(args, kind) if e["name"] == name), None)
+    """``topic|service|action type NAME``: its types, one a line; ros2's "Unknown NOUN 'NAME'" if none
+    (and for a hidden name without ``--include-hidden-...``, as ros2)."""
+    entries = snapshot(args, kind)
+    types = next((e["types"] for e in visible(entries, args) if e["name"] == name), None)
     if types is None:
-        raise RocError(f"Unknown {noun} '{name}'")
+        hidden = any(e["name"] == name for e in entries)
+        hint = f" (a hidden {noun}: add --include-hidden-{kind})" if hidden else ""
+        raise RocError(f"Unknown {noun} '{name}'{hint}")
     render({"name": name, "types": types}, args.format, types)
     return 0

@@ -209,14 +209,19 @@ def stats(graph, params: dict[str, Any]) -> Events:
     what arrived: per topic, lists of publication sequence numbers, source and reception timestamps
     (ns), serialised sizes and, with ``stamps``, header stamps (ns) — never deserialising a message,
     so that a fast topic does not outrun the subscriber. ``subscribed {topic, type}`` (or
-    ``not_published {topic}``, then heartbeats until the topic appears) first, per topic."""
+    ``not_published {topic}``, then heartbeats until the topic appears) first, per topic.
+    Volatile unless ``qos`` says otherwise: a measure counts what is published from now on, and a
+    transient local publisher's history (Fast DDS's writers are transient local by default, depth 1)
+    would come first, late, and count as a delay of up to a period (``topic delay``) or bytes
+    received at once (``topic bw``)."""
     period, stamps = params.get("period", 1.0), params.get("stamps")
+    qos = {**(params.get("qos") or {}), "durability": (params.get("qos") or {}).get("durability") or "volatile"}
     columns = ("sequence", "source", "received", "size", "stamp")
     receiver = Receiver(graph.node)
     try:
         for topic in params["topics"]:
             cls, type_name, found = yield from _topic_class(graph, topic, params, wait_for_type=True)
-            receiver.subscribe(topic, cls, topic, subscription_profile(params.get("qos", {}), found))
+            receiver.subscribe(topic, cls, topic, subscription_profile(qos, found))
             yield {"event": "subscribed", "topic": topic, "type": type_name}
         while True:
             arrived = {topic: {column: [] for column in columns} for topic in params["topics"]}

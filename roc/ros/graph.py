@@ -21,12 +21,13 @@ from rclpy.action import graph as action_graph
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
-from rclpy.node import Node
+from rclpy.node import Node, NodeNameNonExistentError
+from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 
 from roc.errors import RocError
 from roc.ros.params import WRITES, parameter_value
-from roc.ros.protocol import DEFAULT_SPIN_TIME, PARAMETER_TYPES, full_name
+from roc.ros.protocol import DEFAULT_SPIN_TIME, PARAMETER_TYPES, full_name, is_own_node, own_node_name
 from roc.ros.raw_subscription import gid_text
 from roc.ros.type_description import describe
 
@@ -129,8 +130,14 @@ class Graph:
         use_profile(profile)
         self.context = Context()
         rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO, domain_id=domain_id)
-        self.node = Node(node_name or f"_roc_{os.getpid()}", context=self.context, start_parameter_services=False,
-                         enable_rosout=False)
+        # roc's own node shows as little as it can, to other tools too: no parameter, type description
+        # or /rosout endpoints, and no /parameter_events publisher (its parameters never change)
+        self.node = Node(node_name or own_node_name(os.getpid()), context=self.context, start_parameter_services=False,
+                         enable_rosout=False,
+                         parameter_overrides=[Parameter("start_type_description_service", value=False)])
+        for publisher in list(self.node.publishers):
+            if publisher.topic_name == "/parameter_events":
+                self.node.destroy_publisher(publisher)
         self.events = events
         self.executor = EventsExecutor(context=self.context) if events else SingleThreadedExecutor(context=self.context)
         self._stopping = threading.Event()
@@ -192,39 +199,89 @@ class Graph:
                     return False
         return True
 
+    # -- roc's own participants (roc.ros.protocol.is_own_node) are in no answer ---------------------------
+    def _nodes(self, own: bool = False) -> list[tuple[str, str]]:
+        """(name, namespace) of every node but roc's own (``own``: of roc's own only)."""
+        return [(name, namespace) for name, namespace in self.node.get_node_names_and_namespaces()
+                if is_own_node(name) == own]
+
+    def _names_by_node(self, nodes: list[tuple[str, str]], queries) -> set[str]:
+        """The names ``queries`` (functions of node name and namespace) give for ``nodes``."""
+        names: set[str] = set()
+        for name, namespace in nodes:
+            for by_node in queries:
+                try:
+                    names.update(entry for entry, _ in by_node(name, namespace))
+                except NodeNameNonExistentError:  # gone since it was listed
+                    pass
+        return names
+
+    def _others_only(self, pairs, queries) -> list:
+        """``pairs`` (name, types) without the names only roc's own nodes use (by ``queries``)."""
+        own = self._names_by_node(self._nodes(own=True), queries)
+        if not any(name in own for name, _ in pairs):
+            return list(pairs)
+        others = self._names_by_node(self._nodes(), queries)
+        return [(name, types) for name, types in pairs if name not in own or name in others]
+
+    def _endpoints(self, topic: str) -> tuple[list, list]:
+        """The topic's publishers and subscriptions (rclpy endpoint infos) but roc's own."""
+        node = self.node
+        return ([i for i in node.get_publishers_info_by_topic(topic) if not is_own_node(i.node_name)],
+                [i for i in node.get_subscriptions_info_by_topic(topic) if not is_own_node(i.node_name)])
+
+    def _topics(self) -> list[dict[str, Any]]:
+        """Topics with their endpoint counts; roc's own endpoints are not counted, and a topic only they
+        use is left out."""
+        node = self.node
+        own = self._names_by_node(self._nodes(own=True), (node.get_publisher_names_and_types_by_node,
+                                                          node.get_subscriber_names_and_types_by_node))
+        topics = []
+        for topic in _names_and_types(node.get_topic_names_and_types()):
+            if topic["name"] in own:
+                publishers, subscribers = (len(found) for found in self._endpoints(topic["name"]))
+                if not publishers and not subscribers:
+                    continue
+            else:
+                publishers, subscribers = node.count_publishers(topic["name"]), node.count_subscribers(topic["name"])
+            topics.append({**topic, "publishers": publishers, "subscribers": subscribers})
+        return topics
+
     # -- queries --------------------------------------------------------------------------------------
     def snapshot(self, endpoints: bool = False) -> dict[str, Any]:
         """Nodes, topics (with endpoint counts; with ``endpoints``, each topic's endpoints too, as
-        ``topic_endpoints`` gives them: one request instead of one per topic), services and actions."""
+        ``topic_endpoints`` gives them: one request instead of one per topic), services and actions;
+        roc's own left out."""
         node = self.node
-        topics = _names_and_types(node.get_topic_names_and_types())
-        for topic in topics:
-            topic["publishers"] = node.count_publishers(topic["name"])
-            topic["subscribers"] = node.count_subscribers(topic["name"])
-            if endpoints:
-                topic["endpoints"] = {
-                    "publishers": [_endpoint(i) for i in node.get_publishers_info_by_topic(topic["name"])],
-                    "subscribers": [_endpoint(i) for i in node.get_subscriptions_info_by_topic(topic["name"])]}
+        services = self._others_only(node.get_service_names_and_types(), (node.get_service_names_and_types_by_node,
+                                                                          node.get_client_names_and_types_by_node))
+        actions = self._others_only(action_graph.get_action_names_and_types(node), (
+            lambda name, namespace: action_graph.get_action_server_names_and_types_by_node(node, name, namespace),
+            lambda name, namespace: action_graph.get_action_client_names_and_types_by_node(node, name, namespace)))
+        topics = self._topics()
+        if endpoints:
+            for topic in topics:
+                publishers, subscribers = self._endpoints(topic["name"])
+                topic["endpoints"] = {"publishers": [_endpoint(i) for i in publishers],
+                                      "subscribers": [_endpoint(i) for i in subscribers]}
         return {
             "nodes": [{"name": name, "namespace": namespace, "full_name": full_name(namespace, name)}
-                      for name, namespace in sorted(node.get_node_names_and_namespaces(),
-                                                    key=lambda p: full_name(p[1], p[0]))],
+                      for name, namespace in sorted(self._nodes(), key=lambda p: full_name(p[1], p[0]))],
             "topics": topics,
-            "services": _names_and_types(node.get_service_names_and_types()),
-            "actions": _names_and_types(action_graph.get_action_names_and_types(node)),
+            "services": _names_and_types(services),
+            "actions": _names_and_types(actions),
         }
 
     def topic_endpoints(self, topic: str) -> dict[str, Any]:
-        node = self.node
-        types = dict(node.get_topic_names_and_types()).get(topic)
-        if types is None:
+        types = dict(self.node.get_topic_names_and_types()).get(topic)
+        publishers, subscribers = self._endpoints(topic) if types is not None else ([], [])
+        if types is None or not publishers and not subscribers:
             raise NotFound(f"Unknown topic '{topic}'")
         return {"name": topic, "types": list(types),
-                "publishers": [_endpoint(i) for i in node.get_publishers_info_by_topic(topic)],
-                "subscribers": [_endpoint(i) for i in node.get_subscriptions_info_by_topic(topic)]}
+                "publishers": [_endpoint(i) for i in publishers], "subscribers": [_endpoint(i) for i in subscribers]}
 
     def _find_node(self, name: str) -> tuple[str, str]:
-        for node_name, namespace in self.node.get_node_names_and_namespaces():
+        for node_name, namespace in self._nodes():
             if full_name(namespace, node_name) == name:
                 return node_name, namespace
         raise NotFound(f"Unable to find node '{name}'")
@@ -246,8 +303,9 @@ class Graph:
 
     def action_info(self, action: str) -> dict[str, Any]:
         """The nodes serving and using ``action`` with the types they give it."""
-        servers, clients = [], []
-        for node_name, namespace in sorted(self.node.get_node_names_and_namespaces()):
+        servers: list[dict[str, Any]] = []
+        clients: list[dict[str, Any]] = []
+        for node_name, namespace in sorted(self._nodes()):
             for found, query in ((servers, action_graph.get_action_server_names_and_types_by_node),
                                  (clients, action_graph.get_action_client_names_and_types_by_node)):
                 for name, types in query(self.node, node_name, namespace):
@@ -272,12 +330,22 @@ class Graph:
                 "clients": [_service_endpoint(i) for i in clients], "servers": [_service_endpoint(i) for i in servers]}
 
     # -- parameters (service calls to the node) ------------------------------------------------------
+    def wait_for_node(self, node_name: str, timeout: float = 0.0) -> str:
+        """The node's full name (a relative name is taken from the root, as ros2 param does) once the
+        graph knows it, waiting up to ``timeout`` seconds; ros2 param's "Node not found" if it does not."""
+        name = node_name if node_name.startswith("/") else f"/{node_name}"
+        deadline = time.monotonic() + timeout
+        while True:
+            try:
+                self._find_node(name)
+                return name
+            except NotFound:
+                if time.monotonic() >= deadline:
+                    raise NotFound("Node not found") from None
+            time.sleep(POLL_SECONDS)
+
     def call_node_service(self, node_name: str, service: str, srv_type, request) -> Any:
         """Call the node's service ``service`` (e.g. ``set_parameters``) and return the response."""
-        try:
-            self._find_node(node_name)
-        except NotFound:
-            raise NotFound("Node not found") from None  # ros2 param's wording
         client = self.node.create_client(srv_type, f"{node_name.rstrip('/')}/{service}")
         try:
             if not client.wait_for_service(timeout_sec=SERVICE_TIMEOUT):
@@ -349,6 +417,10 @@ class Graph:
 
     def handle(self, method: str, params: dict[str, Any]) -> Any:
         """One request of the daemon protocol (see docs/daemon.md)."""
+        if method == "node_wait" or (method.startswith("param_") and params.get("node")):
+            params = {**params, "node": self.wait_for_node(params["node"], params.get("timeout", 0.0))}
+        if method == "node_wait":
+            return params["node"]
         if method == "snapshot":
             return self.snapshot(params.get("endpoints", False))
         if method == "topic_endpoints":

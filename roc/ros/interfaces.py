@@ -10,6 +10,7 @@ from pathlib import Path
 
 from roc.environment import ament_prefixes
 from roc.errors import RocError
+from roc.messages import did_you_mean
 from roc.ros.types import TypeNameError
 
 KINDS = ("msg", "srv", "action")
@@ -85,7 +86,10 @@ def definition_path(type_name: str) -> Path:
     for candidate in (path.with_name(f"{parts[2]}.{parts[1]}"), path.with_name(f"{parts[2]}.idl")):
         if candidate.is_file():
             return candidate
-    raise RocError(f"Could not find the interface '{path}.idl'")
+    known = package_interfaces(parts[0]).get(parts[0], {}).get(parts[1], [])
+    hint = did_you_mean(parts[2], known) or f"'roc interface package {parts[0]}' lists its interfaces"
+    raise RocError(f"{parts[0]} has no {parts[1]} named '{parts[2]}'; {hint}",
+                   ros2_line=f"Could not find the interface '{path}.idl'")
 
 
 def _comment_start(text: str) -> int:

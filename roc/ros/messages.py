@@ -196,20 +196,30 @@ def echo_text(value: Any, *, csv: bool = False, flow_style: bool = False, no_arr
                            flow_style=flow_style) + "---\n"
 
 
-def get_field(msg: Any, path: str) -> Any:
-    """The value at a dotted field path (``pose.pose.position``), as ``echo --field`` selects it."""
-    value = msg
+def field_names(path: str) -> list[str]:
+    """The names of a dotted field path (``pose.pose.position``), at least one."""
     names = [name for name in path.split(".") if name]
     if not names:
-        raise MessageValueError(f"invalid field '{path}': expected field names separated by dots")
+        raise MessageValueError(f"invalid field '{path}': expected field names separated by dots",
+                                ros2_line=f"Invalid field value '{path}'")
+    return names
+
+
+def get_field(msg: Any, path: str) -> Any:
+    """The value at a dotted field path (``pose.pose.position``), as ``echo --field`` selects it; the
+    errors come after ros2's lines for them."""
+    value = msg
+    names = field_names(path)
     for depth, name in enumerate(names):
         where = ".".join(names[: depth + 1])
+        ros2_line = f"Invalid field '{'.'.join(names)}': '{type(value).__name__}' object has no attribute '{name}'"
         if not hasattr(type(value), "SLOT_TYPES"):
-            raise MessageValueError(f"{where}: '{'.'.join(names[:depth])}' is not a message")
+            raise MessageValueError(f"{where}: '{'.'.join(names[:depth])}' is not a message", ros2_line=ros2_line)
         known = _field_map(value.__class__)
         if name not in known:
             listed = ", ".join(known) or "it has no fields"
-            raise MessageValueError(f"{where}: {type_name(value)} has no field '{name}' ({listed})")
+            raise MessageValueError(f"{where}: {type_name(value)} has no field '{name}' ({listed})",
+                                    ros2_line=ros2_line)
         value = getattr(value, name)
     return value
 

@@ -27,6 +27,20 @@ VALUE_FIELDS = {1: "bool_value", 2: "integer_value", 3: "double_value", 4: "stri
                 8: "double_array_value", 9: "string_array_value"}
 
 
+# roc's own participants (the daemon's, a daemon-less verb's) are nodes named _roc_<pid>: no listing or
+# count roc prints includes them or their endpoints (roc.ros.graph).
+OWN_NODE_PREFIX = "_roc_"
+
+
+def own_node_name(pid: int) -> str:
+    return f"{OWN_NODE_PREFIX}{pid}"
+
+
+def is_own_node(name: str) -> bool:
+    """A node of roc's own (see OWN_NODE_PREFIX); a bridge's (``_roc_bridge_*``) is not."""
+    return name.startswith(OWN_NODE_PREFIX) and name[len(OWN_NODE_PREFIX):].isdigit()
+
+
 def discovery_environment(env: Mapping[str, str] | None = None) -> dict[str, str]:
     env = os.environ if env is None else env
     return {name: env.get(name, "") for name in DISCOVERY_VARIABLES}

@@ -73,12 +73,14 @@ class Window:
         return sorted(s.received if wall_time or s.source is None else s.source for s in self.samples)
 
     def bandwidth(self) -> dict | None:
-        """``{bytes_per_second, messages, mean, min, max}`` (sizes in bytes), or None before two samples."""
+        """``{bytes_per_second, messages, mean, min, max}`` (sizes in bytes), or None before two samples.
+        The bytes per second are those received after the first message over the time since it came:
+        n messages span n - 1 intervals (1 KB messages at 1 Hz are 1 KB/s from the second on)."""
         times = [s.received for s in self.samples]
         if len(times) < 2 or times[-1] == times[0]:
             return None
         sizes = [s.size for s in self.samples]
-        return {"bytes_per_second": sum(sizes) / ((times[-1] - times[0]) * NS), "messages": len(sizes),
+        return {"bytes_per_second": sum(sizes[1:]) / ((times[-1] - times[0]) * NS), "messages": len(sizes),
                 "mean": statistics.fmean(sizes), "min": min(sizes), "max": max(sizes)}
 
     def delay(self) -> dict | None:

@@ -41,6 +41,8 @@ def run(args: argparse.Namespace) -> int:
               "feedback": args.feedback}
     text = args.format != "json"
     goal_id, canceling = None, False
+    if text:  # as ros2, first, whether or not the server is already there
+        print_text("Waiting for an action server to become available...\n")
     with _interruptible() as interrupted:
         for event in stream("goal", params, use_daemon=not args.no_daemon, heartbeats=True):
             kind = event["event"]
@@ -49,9 +51,7 @@ def run(args: argparse.Namespace) -> int:
             if interrupted and not canceling:
                 canceling = True
                 _cancel(args, goal_id)  # then the server ends the goal, and the stream with its result
-            if kind == "waiting" and text:
-                print_text("Waiting for an action server to become available...\n")
-            elif kind == "accepted":
+            if kind == "accepted":
                 goal_id = event["goal_id"]
                 if text:
                     print_text(f"Sending goal:\n     {_indented(request)}\n\nGoal accepted with ID: {goal_id}\n\n")

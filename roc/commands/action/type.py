@@ -4,13 +4,11 @@ from __future__ import annotations
 
 import argparse
 
-from roc.cli.options import add_graph_arguments
-from roc.commands.graph_query import run_type
+from roc.commands.graph_query import add_type_arguments, run_type
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("action_name", help="name of the action, e.g. /fibonacci")
-    add_graph_arguments(parser)
+    add_type_arguments(parser, "action", "actions", "/fibonacci", hidden=False)  # ros2 action type has none
 
 
 def run(args: argparse.Namespace) -> int:

@@ -6,6 +6,7 @@ import argparse
 
 from roc.cli.options import add_graph_arguments
 from roc.commands.graph_query import ask
+from roc.errors import RocError
 from roc.render import render
 from roc.ros.present import is_hidden
 
@@ -16,12 +17,15 @@ SECTIONS = (("subscribers", "Subscribers"), ("publishers", "Publishers"), ("serv
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("node_name", help="fully qualified node name, e.g. /talker")
-    parser.add_argument("--include-hidden", action="store_true", help="include hidden topics and services")
+    parser.add_argument("--include-hidden", action="store_true",
+                        help="show a hidden node, and hidden topics, services and actions")
     add_graph_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:
     info = ask(args, "node_info", {"node": args.node_name})
+    if not args.include_hidden and args.node_name.rpartition("/")[2].startswith("_"):  # ros2's rule for nodes
+        raise RocError(f"Unable to find node '{args.node_name}' (a hidden node: add --include-hidden)")
     for key, _ in SECTIONS:
         info[key] = [e for e in info[key] if args.include_hidden or not is_hidden(e["name"])]
     lines = [info["name"]]

@@ -4,15 +4,13 @@ from __future__ import annotations
 
 import argparse
 
-from roc.cli.options import add_graph_arguments
-from roc.commands.graph_query import ask
+from roc.commands.param.target import add_node_arguments, ask_node
 from roc.render import render
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("node_name", help="fully qualified node name, e.g. /talker")
+    add_node_arguments(parser)
     parser.add_argument("parameter_names", nargs="+", help="names of the parameters")
-    add_graph_arguments(parser)
 
 
 def descriptor_lines(d: dict) -> list[str]:
@@ -33,6 +31,6 @@ def descriptor_lines(d: dict) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    descriptors = ask(args, "param_describe", {"node": args.node_name, "names": args.parameter_names})
+    descriptors = ask_node(args, "param_describe", {"names": args.parameter_names})
     render(descriptors, args.format, [line for d in descriptors for line in descriptor_lines(d)])
     return 0

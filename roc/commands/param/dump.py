@@ -4,14 +4,12 @@ from __future__ import annotations
 
 import argparse
 
-from roc.cli.options import add_graph_arguments
-from roc.commands.graph_query import ask
+from roc.commands.param.target import add_node_arguments, ask_node
 from roc.render import render, to_yaml
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("node_name", help="fully qualified node name, e.g. /talker")
-    add_graph_arguments(parser)
+    add_node_arguments(parser)
 
 
 def nested(values: dict[str, dict]) -> dict:
@@ -27,7 +25,7 @@ def nested(values: dict[str, dict]) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    values = ask(args, "param_dump", {"node": args.node_name})
+    values = ask_node(args, "param_dump")
     document = {args.node_name: {"ros__parameters": nested(values)}}
     render(document, args.format, [to_yaml(document)])
     return 0

@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from roc.cli.options import add_graph_arguments
-from roc.commands.graph_query import ask
+from roc.commands.param.target import add_node_arguments, ask_node
 from roc.errors import RocError
 from roc.render import render
 
@@ -21,14 +20,13 @@ def python_text(value) -> str:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("node_name", help="fully qualified node name, e.g. /talker")
+    add_node_arguments(parser)
     parser.add_argument("parameter_name", help="name of the parameter")
     parser.add_argument("--hide-type", action="store_true", help="print only the value")
-    add_graph_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:
-    values = ask(args, "param_get", {"node": args.node_name, "names": [args.parameter_name]})
+    values = ask_node(args, "param_get", {"names": [args.parameter_name]})
     if not values:
         raise RocError("Parameter not set")
     value = values[0]

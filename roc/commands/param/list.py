@@ -3,15 +3,20 @@
 from __future__ import annotations
 
 import argparse
+import re
 
 from roc.cli.options import add_graph_arguments
 from roc.commands.graph_query import ask
-from roc.errors import RocError
+from roc.commands.param.target import absolute_node_name
+from roc.errors import RocError, UsageError
 from roc.render import render
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("node_name", nargs="?", help="fully qualified node name; every node when left out")
+    parser.add_argument("node_name", nargs="?", type=absolute_node_name,
+                        help="node name (a relative one is taken from the root); every node when left out")
+    parser.add_argument("--filter", dest="filter_regex", metavar="REGEX",
+                        help="only parameters whose names match this regular expression (from their start)")
     parser.add_argument("--param-prefixes", nargs="+", default=[], metavar="PREFIX",
                         help="only parameters with one of these prefixes")
     parser.add_argument("--param-type", action="store_true", help="print each parameter's type")
@@ -19,11 +24,25 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_graph_arguments(parser)
 
 
+def _matching(pattern: str | None):
+    if pattern is None:
+        return lambda _name: True
+    try:
+        return re.compile(pattern).match
+    except re.error as error:
+        raise UsageError(f"--filter: invalid pattern '{pattern}': {error}") from None
+
+
 def run(args: argparse.Namespace) -> int:
     if args.node_name and args.node_name.rsplit("/", 1)[-1].startswith("_") and not args.include_hidden_nodes:
         raise RocError("Node not found")  # ros2's rule: a node whose own name starts with '_' is hidden
+    matches = _matching(args.filter_regex)
     nodes = ask(args, "param_list", {"node": args.node_name, "prefixes": args.param_prefixes,
                                      "types": args.param_type, "hidden": args.include_hidden_nodes})
+    for entry in nodes:
+        entry["parameters"] = [p for p in entry["parameters"] if matches(p["name"])]
+    if not args.node_name:  # as ros2, a node none of whose parameters is listed is left out
+        nodes = [entry for entry in nodes if entry["parameters"]]
     lines = []
     for entry in nodes:
         if not args.node_name:

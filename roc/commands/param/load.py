@@ -7,18 +7,20 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from roc.cli.options import add_graph_arguments
-from roc.commands.graph_query import ask
 from roc.commands.param.set import report, set_parameters, typed_value
+from roc.commands.param.target import add_node_arguments, ask_node
 from roc.errors import UsageError
 from roc.fsutil import read_yaml
 from roc.messages import warn
 
+WILDCARD = "/**"
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("node_name", help="fully qualified node name, e.g. /talker")
+    add_node_arguments(parser)
     parser.add_argument("parameter_file", type=Path, help="YAML file: {NODE or /**: {ros__parameters: {...}}}")
-    add_graph_arguments(parser)
+    parser.add_argument("--no-use-wildcard", action="store_true",
+                        help=f"leave out the parameters of the file's '{WILDCARD}' section (for every node)")
 
 
 def flattened(tree: dict[str, Any], prefix: str = "") -> dict[str, Any]:
@@ -33,13 +35,13 @@ def flattened(tree: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     return flat
 
 
-def file_parameters(path: Path, node: str) -> dict[str, Any]:
-    """The parameters the file gives ``node`` (its own section over ``/**``)."""
+def file_parameters(path: Path, node: str, use_wildcard: bool = True) -> dict[str, Any]:
+    """The parameters the file gives ``node``: its own section over the ``/**`` one (``use_wildcard``)."""
     document = read_yaml(path)
     if not isinstance(document, dict):
         raise UsageError(f"{path}: expected a mapping of node names to {{ros__parameters: ...}}")
     values: dict[str, Any] = {}
-    for key in ("/**", node, node.lstrip("/")):
+    for key in ((WILDCARD,) if use_wildcard else ()) + (node, node.lstrip("/")):
         section = document.get(key)
         if section is None:
             continue
@@ -47,19 +49,22 @@ def file_parameters(path: Path, node: str) -> dict[str, Any]:
             raise UsageError(f"{path}: '{key}' has no 'ros__parameters' mapping")
         values.update(flattened(section["ros__parameters"]))
     if not values:
-        raise UsageError(f"{path}: no parameters for {node} (sections: {', '.join(map(str, document)) or 'none'})")
+        raise UsageError(f"{path}: no parameters for {node} (sections: {', '.join(map(str, document)) or 'none'}"
+                         + ("; --no-use-wildcard leaves out '/**'" if not use_wildcard and WILDCARD in document else "")
+                         + ")", ros2_line="Param file does not contain selected parameters")
     return values
 
 
 def run(args: argparse.Namespace) -> int:
     """Read-only parameters (which param dump writes too) are left out with a note, so that a dump
-    loads back; exit 1 when the node refused another."""
-    values = file_parameters(args.parameter_file, args.node_name)
-    descriptors = ask(args, "param_describe", {"node": args.node_name, "names": list(values)})
+    loads back; exit 1 when the node refused another. As ros2, the node is looked for first."""
+    ask_node(args, "node_wait")
+    values = file_parameters(args.parameter_file, args.node_name, use_wildcard=not args.no_use_wildcard)
+    descriptors = ask_node(args, "param_describe", {"names": list(values), "timeout": 0})
     read_only = [d["name"] for d in descriptors if d["read_only"]]
     for name in read_only:
         warn(f"{args.parameter_file}: {name} is read-only on {args.node_name}; not set")
-    results = set_parameters(args, args.node_name, [{"name": name, **typed_value(value)}
+    results = set_parameters(args, [{"name": name, **typed_value(value)}
                                                     for name, value in values.items() if name not in read_only])
     return report(args, results, lambda name: f"Set parameter {name} successful",
                   lambda name: f"Set parameter {name} failed")

@@ -9,8 +9,7 @@ from typing import Any
 
 import yaml
 
-from roc.cli.options import add_graph_arguments
-from roc.commands.graph_query import ask
+from roc.commands.param.target import add_node_arguments, ask_node
 from roc.errors import UsageError
 from roc.render import print_lines, render
 
@@ -43,16 +42,15 @@ def parse_value(text: str) -> dict[str, Any]:
     return typed_value(value, text)
 
 
-def set_parameters(args: argparse.Namespace, node: str, parameters: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Send the parameters ({name, type, value}) to the node; the node's verdict per parameter."""
-    return ask(args, "param_set", {"node": node, "parameters": parameters})
+def set_parameters(args: argparse.Namespace, parameters: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Send the parameters ({name, type, value}) to ``args.node_name``; the node's verdict per parameter."""
+    return ask_node(args, "param_set", {"parameters": parameters})
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("node_name", help="fully qualified node name, e.g. /talker")
+    add_node_arguments(parser)
     parser.add_argument("assignments", nargs="+", metavar="NAME VALUE",
                         help="parameter name and value (YAML: 1 is an integer, 1.0 a double, [1, 2] an array)")
-    add_graph_arguments(parser)
 
 
 def named_reason(name: str, reason: str) -> str:
@@ -76,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
     if len(args.assignments) % 2:
         raise UsageError(f"parameter '{args.assignments[-1]}' has no value: give NAME VALUE pairs")
     pairs = list(zip(args.assignments[::2], args.assignments[1::2]))
-    results = set_parameters(args, args.node_name, [{"name": name, **parse_value(text)} for name, text in pairs])
+    results = set_parameters(args, [{"name": name, **parse_value(text)} for name, text in pairs])
     if len(results) == 1:  # ros2's text for one parameter
         return report(args, results, lambda _: "Set parameter successful", lambda _: "Setting parameter failed")
     return report(args, results, lambda name: f"Set parameter {name} successful",

@@ -4,13 +4,11 @@ from __future__ import annotations
 
 import argparse
 
-from roc.cli.options import add_graph_arguments
-from roc.commands.graph_query import run_type
+from roc.commands.graph_query import add_type_arguments, run_type
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("service_name", help="name of the service, e.g. /talker/list_parameters")
-    add_graph_arguments(parser)
+    add_type_arguments(parser, "service", "services", "/talker/list_parameters")
 
 
 def run(args: argparse.Namespace) -> int:

@@ -11,7 +11,7 @@ from roc.commands.graph_query import publisher_wait
 from roc.errors import RocError, UsageError
 from roc.render import json_line, print_text
 from roc.ros.client import stream
-from roc.ros.messages import echo_text, get_field, value_to_data
+from roc.ros.messages import echo_text, field_names, get_field, value_to_data
 from roc.ros.types import message_class
 
 DEFAULT_TRUNCATE_LENGTH = 128
@@ -66,6 +66,8 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("--flow-style does not apply to --csv output")
     if args.message_type:
         message_class(args.message_type)  # an unknown type is an error before any waiting
+    if args.field is not None:
+        field_names(args.field)  # as is a field path without a name
     accept = message_filter(args.filter_expr)
     limit = None if args.full_length else args.truncate_length
     options = {"no_arr": args.no_arr, "no_str": args.no_str, "truncate_length": limit}

@@ -14,8 +14,8 @@ from roc.render import table_lines
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_stats_arguments(parser, window=10000, several=True)
     parser.add_argument("--filter", dest="filter_expr", metavar="EXPR",
-                        help="count only messages for which this Python expression of m (the message) is true "
-                             "(one topic; messages are deserialised)")
+                        help="the rate of the messages for which this Python expression of m (the message) is "
+                             "true (one topic; messages are deserialised, and losses are not counted)")
     parser.add_argument("--wall-time", action="store_true",
                         help="measure with the times messages were received, not the times they were published")
 

@@ -70,7 +70,9 @@ def print_lines_of(lines: list[str]) -> None:
 
 
 def _filtered(args: argparse.Namespace, topic: str, accept, wait: float):
-    """``batch`` events from the ``echo`` stream, with only the messages ``accept`` takes."""
+    """``batch`` events from the ``echo`` stream, with only the messages ``accept`` takes. Without their
+    sequence numbers: the messages left out are not lost, and the rate is of those that pass (counted
+    over their source timestamps), not the publisher's."""
     import base64
 
     from roc.ros.cdr import decode
@@ -88,7 +90,7 @@ def _filtered(args: argparse.Namespace, topic: str, accept, wait: float):
                 if accept(decode(type_name, message["data"])):
                     info = message["info"]
                     for column, value in zip(columns, (
-                            info.get("publication_sequence_number"), info.get("source_timestamp"),
+                            None, info.get("source_timestamp"),
                             info.get("received_timestamp"), len(base64.b64decode(message["data"])), None)):
                         batch[column].append(value)
         if time.monotonic() >= due:

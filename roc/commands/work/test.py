@@ -46,7 +46,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add("--output", choices=("text", "json"), default="text", help="json: one JSON event per line on stdout")
     add("--force", action="store_true", help="test the selected packages even when their results are cached")
     add("--no-cache", action="store_true", help="neither reuse passing results nor record them")
-    add_selection_arguments(parser, previous_test=True)
+    add_selection_arguments(parser)
 
 
 class TestFailureKeys:
