@@ -186,7 +186,8 @@ def test_only_close_interface_package_names_are_suggested() -> None:
 ])
 def test_a_mistyped_command_gets_the_closest_name(tmp_path: Path, words: list[str], hint: str) -> None:
     result = cli(*words, env=ros_env(), cwd=tmp_path)
-    assert (result.returncode, result.stdout, result.stderr) == (2, "", f"roc: error: {hint}\n")
+    group = hint.rsplit("(see '", 1)[1].split(" --help")[0]  # the group's parser reports it, as argparse does
+    assert (result.returncode, result.stdout, result.stderr) == (2, "", f"{group}: error: {hint}\n")
 
 
 def _help_of(name: str, parent_help: str) -> str:
