@@ -49,3 +49,21 @@ def test_no_test_hard_codes_a_domain():
             owners.setdefault(int(slot), set()).add(path.name)
     shared = {slot: files for slot, files in owners.items() if len(files) > 1}
     assert not shared, f"domain slots used by several test files: {shared}"
+
+
+def test_an_xdist_group_runs_on_one_worker(tmp_path):
+    """scripts/test.sh's --dist loadgroup keeps the tests of an xdist_group on one worker (the bridge
+    tests' busy processes apart from timing tests; each ported ros2cli file's graph started once). A
+    pytest that pytest-xdist cannot read the group of would spread them silently."""
+    import subprocess
+    import sys
+
+    (tmp_path / "test_grouped.py").write_text(
+        "import os, pytest\n\n\n@pytest.mark.xdist_group('g')\n@pytest.mark.parametrize('i', range(6))\n"
+        "def test_worker(i):\n    print('worker', os.environ['PYTEST_XDIST_WORKER'])\n")
+    run = subprocess.run([sys.executable, "-m", "pytest", "-n", "2", "--dist", "loadgroup", "-rA", "-s", "-q",
+                          "-p", "no:cacheprovider", str(tmp_path / "test_grouped.py")],
+                         capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert run.returncode == 0, run.stdout + run.stderr
+    workers = set(re.findall(r"worker (gw\d+)", run.stdout))
+    assert len(workers) == 1, run.stdout
