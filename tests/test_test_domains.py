@@ -61,7 +61,7 @@ def test_an_xdist_group_runs_on_one_worker(tmp_path):
     (tmp_path / "test_grouped.py").write_text(
         "import os, pytest\n\n\n@pytest.mark.xdist_group('g')\n@pytest.mark.parametrize('i', range(6))\n"
         "def test_worker(i):\n    print('worker', os.environ['PYTEST_XDIST_WORKER'])\n")
-    run = subprocess.run([sys.executable, "-m", "pytest", "-n", "2", "--dist", "loadgroup", "-rA", "-s", "-q",
+    run = subprocess.run([sys.executable, "-m", "pytest", "-n", "2", "--dist", "loadgroup", "-rA", "-q",
                           "-p", "no:cacheprovider", str(tmp_path / "test_grouped.py")],
                          capture_output=True, text=True, timeout=120, cwd=tmp_path)
     assert run.returncode == 0, run.stdout + run.stderr
