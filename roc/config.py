@@ -54,6 +54,25 @@ def _line_of(text: str, table: str, key: str) -> int | None:
     return None
 
 
+def header_lines(text: str, name: str) -> list[int]:
+    """The lines of every ``[name]`` or ``[[name]]`` header (a dotted name, parts maybe quoted), in order."""
+    dotted = r"\s*\.\s*".join(rf'"?{re.escape(part)}"?' for part in name.split("."))
+    pattern = re.compile(rf"^\s*\[\[?\s*{dotted}\s*\]")
+    return [number for number, line in enumerate(text.splitlines(), 1) if pattern.match(line)]
+
+
+def key_line(text: str, start: int, key: str) -> int:
+    """The line of ``key`` in the table whose header is on line ``start`` (the header's line if absent)."""
+    lines = text.splitlines()
+    for number in range(start + 1, len(lines) + 1):
+        line = lines[number - 1]
+        if line.lstrip().startswith("["):
+            break
+        if re.match(rf'\s*"?{re.escape(key)}"?\s*=', line):
+            return number
+    return start
+
+
 class Setting:
     """One configured value and where it came from."""
 
@@ -242,11 +261,13 @@ def _load_roc_toml(config: Configuration, path: Path, verb: str, profile: str | 
             raise UsageError(f"{path}:{len(lines)}:{len(lines[-1]) + 1}: invalid TOML: "
                              f"{str(error).split(' (at ')[0]} (at the end of the file)") from None
         raise UsageError(f"{path}: invalid TOML: {error}") from None
-    known_tables = {"defaults", "profile", "package", "check", *VERBS}  # [check]: roc.check.expectations
+    # [check]: roc.check.expectations; [launch.NAME]: roc.launch.system
+    known_tables = {"defaults", "profile", "package", "check", "launch", *VERBS}
     for table, values in data.items():
         if table not in known_tables or not isinstance(values, dict):
-            raise ConfigError(path, table, f"unknown table; {_closest(table, known_tables)}use [defaults], [{'], ['.join(VERBS)}], "
-                                           "[profile.NAME], [package.NAME]", _line_of(text, table, table) or
+            raise ConfigError(path, table, f"unknown table; {_closest(table, known_tables)}use [defaults], "
+                                           f"[{'], ['.join(VERBS)}], [profile.NAME], [package.NAME], [check], "
+                                           "[launch.NAME]", _line_of(text, table, table) or
                               next((n for n, line in enumerate(text.splitlines(), 1) if f"[{table}" in line), None))
     config.add_layer(data.get("defaults", {}), f"{ROC_TOML} [defaults]", path, "defaults", text)
     config.add_layer(data.get(verb, {}), f"{ROC_TOML} [{verb}]", path, verb, text)

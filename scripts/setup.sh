@@ -107,6 +107,16 @@ pip_q install -q --upgrade --target "$VENV/oracle-setuptools" "setuptools==68.1.
 # ---- fix-ups of the wheels' CMake files ---------------------------------------------------
 "$VPY" "$ROOT/scripts/fix_ros_wheels.py"
 
+# ---- the ROS 2 launch system (launch, launch_xml, launch_yaml, launch_ros, composition_interfaces) ----
+# Not on PyPI: for roc launch's tests and development it comes from the shared oracles' installer, when
+# present (idempotent, quick when installed). Users get it from their ROS 2 installation.
+LAUNCH_INSTALLER="$ROOT/../shared/oracles/install_launch.sh"
+if [ -f "$LAUNCH_INSTALLER" ]; then
+    say "installing the ROS 2 launch system ($LAUNCH_INSTALLER)"
+    bash "$LAUNCH_INSTALLER" "$VENV" >/dev/null 2>"$VENV/.install-launch.log" \
+        || { tail -20 "$VENV/.install-launch.log" >&2; die "installing the launch system failed (log: $VENV/.install-launch.log)"; }
+fi
+
 # ---- byte-code, as a pip install writes it (PYTHONDONTWRITEBYTECODE=1 may be set machine-wide,
 # and an editable install would then recompile every roc module on every run) ----------------
 "$VPY" -m compileall -q "$ROOT/roc" >/dev/null

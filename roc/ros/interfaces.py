@@ -4,12 +4,10 @@ no rclpy, no daemon."""
 
 from __future__ import annotations
 
-import os
 import re
-import sys
 from pathlib import Path
 
-from roc.environment import path_list
+from roc.ament_index import resources
 from roc.errors import RocError
 
 KINDS = ("msg", "srv", "action")
@@ -18,36 +16,15 @@ PRIMITIVES = {"bool", "byte", "char", "float32", "float64", "int8", "uint8", "in
 SEPARATOR = "---"
 
 
-def prefixes() -> list[Path]:
-    """AMENT_PREFIX_PATH; when unset, roc's own prefix if it holds an ament index (ROS from wheels)."""
-    value = os.environ.get("AMENT_PREFIX_PATH")
-    if value:
-        return [Path(p) for p in path_list(value)]
-    prefix = Path(sys.prefix)
-    return [prefix] if (prefix / "share" / "ament_index" / "resource_index").is_dir() else []
-
-
-def _resources(kind: str) -> dict[str, Path]:
-    """Resource name -> the first prefix that registers it (earlier prefixes overlay later ones)."""
-    found: dict[str, Path] = {}
-    for prefix in prefixes():
-        directory = prefix / "share" / "ament_index" / "resource_index" / kind
-        if directory.is_dir():
-            for entry in directory.iterdir():
-                if not entry.name.startswith("."):
-                    found.setdefault(entry.name, prefix)
-    return found
-
-
 def interface_packages() -> list[str]:
-    return sorted(_resources("rosidl_interfaces"))
+    return sorted(resources("rosidl_interfaces"))
 
 
 def package_interfaces(package: str | None = None) -> dict[str, dict[str, list[str]]]:
     """{package: {"msg": [names], "srv": [...], "action": [...]}}, hidden ones (with '_') left out."""
-    registered = _resources("rosidl_interfaces")
+    registered = resources("rosidl_interfaces")
     if package is not None:
-        if package not in _resources("packages"):
+        if package not in resources("packages"):
             raise RocError(f"Unknown package '{package}'")
         registered = {package: registered[package]} if package in registered else {}
     result = {}
@@ -67,7 +44,7 @@ def definition_path(type_name: str) -> Path:
     parts = type_name.split("/")
     if len(parts) != 3 or not all(parts) or ".." in parts:
         raise RocError(f"Invalid name '{type_name}'. Expected three parts separated by '/'")
-    prefix = _resources("packages").get(parts[0])
+    prefix = resources("packages").get(parts[0])
     if prefix is None:
         raise RocError(f"Unknown package '{parts[0]}'")
     path = prefix / "share" / type_name
