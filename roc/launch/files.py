@@ -33,13 +33,13 @@ def find_in_package(package: str, file_name: str) -> Path:
     share = share_directory(package)
     matches = sorted(Path(directory, file_name) for directory, _, files in os.walk(share) if file_name in files)
     if len(matches) > 1:
-        raise UsageError(f"file '{file_name}' is in the share directory of package '{package}' "
+        raise RocError(f"file '{file_name}' is in the share directory of package '{package}' "
                          f"{len(matches)} times: {', '.join(map(str, matches))}; give the path of the one to launch")
     if not matches:
         available = [str(path) for path in launch_files(share)]
         hint = did_you_mean(file_name, [Path(name).name for name in available], count=1)
         listing = f"its launch files: {', '.join(available)}" if available else "it has no launch files"
-        raise UsageError(f"no file '{file_name}' in the share directory of package '{package}' ({share}); "
+        raise RocError(f"no file '{file_name}' in the share directory of package '{package}' ({share}); "
                          f"{hint + ' ' if hint else ''}({listing})")
     return matches[0]
 

@@ -7,6 +7,7 @@ Thread-safe: events come from the threads that read the processes' output.
 
 from __future__ import annotations
 
+import re
 import threading
 import time
 from dataclasses import dataclass, field
@@ -14,6 +15,9 @@ from pathlib import Path
 from typing import Protocol
 
 from roc.launch.logs import ProcessLogs
+
+# the time stamp of a ROS log line, "[INFO] [1795613360.189655492] [talker]: ...", left out of the view
+ROS_STAMP = re.compile(r"^(\[[A-Z]+\] )\[\d+\.\d+\] ")
 
 
 class Output(Protocol):
@@ -94,7 +98,7 @@ class Monitor:
             complete = [line.rstrip("\r") for line in lines[:-1]]
             shown = [line for line in complete if line.strip()]
             if shown:
-                self._row(name).last_line = shown[-1]
+                self._row(name).last_line = ROS_STAMP.sub(r"\1", shown[-1], count=1)
         if self.echo:
             for line in complete:
                 self.output.line(f"[{name}] {line}")

@@ -5,6 +5,7 @@ the task of another process (``process NAME started``). The engine's order is th
 
 from __future__ import annotations
 
+import shlex
 import threading
 from collections.abc import Callable
 
@@ -83,14 +84,18 @@ def _starter(spec: ProcessSpec, start: Callable[[ProcessSpec], None], stopped: C
 
 
 def start_order(tasks: list[Task]) -> list[Task]:
-    """The tasks in an order the engine may start them (dependencies first)."""
-    queue = ReadyQueue({task.key: task for task in tasks})
-    order = []
-    while queue.has_ready():
-        task = queue.pop()
-        order.append(task)
-        queue.done(task.key)
-    return order
+    """The tasks in start-up order: by how many tasks wait before them (a probe counts as one), then as
+    declared."""
+    by_key = {task.key: task for task in tasks}
+    depth: dict[str, int] = {}
+
+    def depth_of(key: str) -> int:
+        if key not in depth:
+            task = by_key[key]
+            depth[key] = 1 + max((depth_of(d) for d in task.dependencies), default=-1)
+        return depth[key]
+
+    return sorted(tasks, key=lambda task: depth_of(task.key))
 
 
 def explain(system: System, tasks: list[Task], command: Callable[[ProcessSpec], list[str]]) -> list[str]:
@@ -105,5 +110,5 @@ def explain(system: System, tasks: list[Task], command: Callable[[ProcessSpec], 
         waits = [condition.text for condition in spec.after]
         lines.append(f"{spec.label}: {'starts after: ' + ', '.join(waits) if waits else 'starts at once'}"
                      f"{' (respawns)' if spec.respawn else ''}")
-        lines.append(f"    {' '.join(command(spec))}")
+        lines.append(f"    {shlex.join(command(spec))}")
     return lines
