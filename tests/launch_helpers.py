@@ -72,8 +72,9 @@ class Launcher:
 
 
 def roc_launch(*args: str, env: dict[str, str], log: Path, cwd: Path | None = None) -> Launcher:
-    """roc launch in ``cwd`` (default: the log's directory, where its log/ then goes)."""
-    return Launcher([str(BIN / "roc"), "launch", *args], env, log, cwd or log.parent)
+    """roc launch in ``cwd`` (default: the log's directory), its logs in log/ beside ``log``."""
+    return Launcher([str(BIN / "roc"), "launch", "--log-base", str(log.parent / "log"), *args], env, log,
+                    cwd or log.parent)
 
 
 def ros2_launch(*args: str, env: dict[str, str], log: Path) -> Launcher:
