@@ -50,7 +50,7 @@ def launch_system(system: System, options: RunOptions, use_daemon: bool, spin_ti
         for spec in system.processes:
             if spec.after:
                 running.monitor.waiting(spec.label, ", ".join(condition.text for condition in spec.after))
-        result = execute(tasks, [_start_up_notes(running, system)], workers=0)
+        result = execute(tasks, [_start_up_notes(running, system)], workers=0, continue_on_error=True)
         session.close()
         if result.interrupted:
             running.stopping.set()
