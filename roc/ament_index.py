@@ -47,7 +47,7 @@ class PackageNotFound(RocError):
     """A package the ament index does not have; the message names the closest ones."""
 
     def __init__(self, name: str, known: dict[str, Path]):
-        hint = did_you_mean(name, known, quote=False) or "run 'roc pkg list' to see the installed packages"
+        hint = did_you_mean(name, known, count=1, quote=False) or "run 'roc pkg list' to see the installed packages"
         where = ", ".join(str(p) for p in prefixes()) or "AMENT_PREFIX_PATH is empty"
         super().__init__(f"package '{name}' not found in the ament index ({where}); {hint}")
 
