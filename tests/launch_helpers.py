@@ -68,7 +68,8 @@ class Launcher:
             return self.process.wait(timeout=timeout)
         except subprocess.TimeoutExpired:
             stop_process(self.process)
-            raise AssertionError(f"{self.process.args[:3]} did not stop within {timeout:g} s after {signum!r}") from None
+            raise AssertionError(f"{self.process.args[:3]} did not stop within {timeout:g} s after "
+                                 f"{signum!r}") from None
 
 
 def roc_launch(*args: str, env: dict[str, str], log: Path, cwd: Path | None = None) -> Launcher:

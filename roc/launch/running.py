@@ -85,7 +85,8 @@ class Running:
             if self.stopping.is_set():
                 return
             try:
-                self.check_passed = run_checks(checks, options, self.output, self.stopping.is_set)
+                self.check_passed = run_checks(checks, options, self.output,  # type: ignore[arg-type]
+                                               self.stopping.is_set)
             except Exception as error:  # noqa: BLE001 - a check that cannot run is a failed check, not a crash
                 self.monitor.note(f"[ERROR] [roc]: --check {options.path}: {error}")
                 self.check_passed = False

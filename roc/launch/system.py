@@ -131,7 +131,8 @@ def load_system(path: Path, name: str) -> System:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise UsageError(f"{path}: invalid TOML: {error}") from None
-    systems = data.get("launch") if isinstance(data.get("launch"), dict) else {}
+    launch = data.get("launch")
+    systems: dict[str, Any] = launch if isinstance(launch, dict) else {}
     if name not in systems:
         hint = did_you_mean(name, systems, count=1)
         raise UsageError(f"{path} has no [launch.{name}]; {hint + ' ' if hint else ''}"
@@ -190,9 +191,10 @@ def _process(path: Path, text: str, entry: Any, start: int, system: str) -> Proc
         types, _ = PROCESS_KEYS[key]
         if not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
             raise ConfigError(path, key, f"expected {_type_names(types)}, got {value!r}", line)
-        if key in ("remappings", "env") and not all(isinstance(v, str) for v in value.values()):
+        given: Any = entry[key]  # its type checked above
+        if key in ("remappings", "env") and not all(isinstance(v, str) for v in given.values()):
             raise ConfigError(path, key, "expected a table of strings", line)
-        if key in ("arguments", "after") and not all(isinstance(v, str) for v in value):
+        if key in ("arguments", "after") and not all(isinstance(v, str) for v in given):
             raise ConfigError(path, key, "expected a list of strings", line)
     for key, (_, required) in PROCESS_KEYS.items():
         if required and key not in entry:
