@@ -6,3 +6,14 @@ import signal
 
 if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
+import pytest  # noqa: E402
+
+
+@pytest.fixture(scope="session")
+def launch_demo_prefix(tmp_path_factory):
+    """roc_launch_demo (workspaces/fixtures/launch) built by roc once per test worker: its install prefix."""
+    from launch_helpers import build_demo
+
+    return build_demo(tmp_path_factory.mktemp("launch_demo"))

@@ -10,7 +10,6 @@ from pathlib import Path
 import pytest
 from graph_helpers import install_oracle, roc, ros2, stop_daemon
 from launch_helpers import (
-    build_demo,
     demo_env,
     describe,
     kill_leftovers,
@@ -27,11 +26,11 @@ NODES = {"/r7/talker", "/r7/listener", "/map_server"}
 
 
 @pytest.fixture(scope="module")
-def demo(tmp_path_factory):
+def demo(tmp_path_factory, launch_demo_prefix):
     reason = install_oracle(launch=True)
     if reason:
         pytest.skip(f"no ros2 launch oracle: {reason}")
-    prefix = build_demo(tmp_path_factory.mktemp("launch_files"))
+    prefix = launch_demo_prefix
     env = demo_env(29, tmp_path_factory.mktemp("runtime"), prefix)
     yield env, prefix
     stop_daemon(env)
@@ -70,7 +69,7 @@ def test_roc_and_ros2_launch_start_the_same_system(demo, tmp_path: Path, file: s
     assert "[talker-1] [INFO] [" in outputs["roc"]  # the processes' output, prefixed as ros2 launch does
 
 
-@pytest.mark.parametrize("file", FORMATS)
+@pytest.mark.parametrize("file", [FORMATS[0], *(pytest.param(f, marks=pytest.mark.slow) for f in FORMATS[1:])])
 def test_show_args_prints_what_ros2_launch_prints(demo, file: str) -> None:
     env, _ = demo
     ours = roc("launch", "-s", PACKAGE, file, env=env)
@@ -79,6 +78,7 @@ def test_show_args_prints_what_ros2_launch_prints(demo, file: str) -> None:
     assert "'rate':\n        publishing rate of the talker\n        (default: '5.0')" in ours.stdout
 
 
+@pytest.mark.slow
 def test_print_describes_the_launch_file_as_ros2_launch_does(demo) -> None:
     env, prefix = demo
     path = prefix / "share" / PACKAGE / "launch" / "demo.launch.py"

@@ -13,7 +13,6 @@ import pytest
 from graph_helpers import install_oracle, stop_daemon
 from launch_helpers import (
     DEMO_NODES,
-    build_demo,
     demo_env,
     kill_leftovers,
     nodes,
@@ -28,8 +27,8 @@ PACKAGE = "roc_launch_demo"
 
 
 @pytest.fixture(scope="module")
-def demo(tmp_path_factory):
-    prefix = build_demo(tmp_path_factory.mktemp("launch_stop"))
+def demo(tmp_path_factory, launch_demo_prefix):
+    prefix = launch_demo_prefix
     env = demo_env(30, tmp_path_factory.mktemp("runtime"), prefix)
     yield env, prefix
     stop_daemon(env)

@@ -12,7 +12,6 @@ from pathlib import Path
 import pytest
 from graph_helpers import roc, stop_daemon
 from launch_helpers import (
-    build_demo,
     demo_env,
     kill_leftovers,
     nodes,
@@ -69,8 +68,8 @@ after = ["node /nobody exists"]
 
 
 @pytest.fixture(scope="module")
-def demo(tmp_path_factory):
-    prefix = build_demo(tmp_path_factory.mktemp("launch_system"))
+def demo(tmp_path_factory, launch_demo_prefix):
+    prefix = launch_demo_prefix
     env = demo_env(31, tmp_path_factory.mktemp("runtime"), prefix)
     yield env, prefix
     stop_daemon(env)

@@ -12,14 +12,14 @@ from pathlib import Path
 import pytest
 from build_helpers import BIN
 from graph_helpers import install_oracle, roc, ros2, stop_daemon
-from launch_helpers import build_demo, demo_env, kill_leftovers, wait_for_nodes
+from launch_helpers import demo_env, kill_leftovers, wait_for_nodes
 
 PACKAGE = "roc_launch_demo"
 
 
 @pytest.fixture(scope="module")
-def demo(tmp_path_factory):
-    prefix = build_demo(tmp_path_factory.mktemp("pkg_run"))
+def demo(tmp_path_factory, launch_demo_prefix):
+    prefix = launch_demo_prefix
     env = demo_env(28, tmp_path_factory.mktemp("runtime"), prefix)
     yield env, prefix
     stop_daemon(env)
@@ -33,6 +33,7 @@ def oracle():
         pytest.skip(f"no ros2 oracle: {reason}")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("verb", [
     ["list"], ["executables"], ["executables", PACKAGE], ["executables", "--full-path", PACKAGE],
     ["prefix", PACKAGE], ["prefix", "--share", "rclpy"], ["xml", PACKAGE], ["xml", "std_msgs", "-t", "depend"],
