@@ -107,3 +107,19 @@ def test_a_missing_file_or_package_is_one_line_listing_what_exists(demo, tmp_pat
     assert malformed.returncode == 2 and "launch argument 'rate:=': expected NAME:=VALUE" in malformed.stderr
     nothing = roc("-C", str(tmp_path), "launch", "no_such_system", env=env)
     assert nothing.returncode == 2 and "'no_such_system' is not a launch file, and no roc.toml here" in nothing.stderr
+
+
+def test_a_broken_launch_file_fails_as_in_ros2_launch(demo, tmp_path: Path) -> None:
+    env, _ = demo
+    broken = tmp_path / "broken.launch.py"
+    broken.write_text("from launch import LaunchDescription\n\ndef generate_launch_description():\n"
+                      "    return LaunchDescription([undefined_action()])\n")
+    ours = roc("launch", "--log-base", str(tmp_path / "log"), str(broken), env=env)
+    theirs = ros2("launch", str(broken), env=env)
+    assert (ours.returncode, theirs.returncode) == (1, 1)
+
+    def error(output: str) -> str:
+        return output[output.index("[ERROR] [launch]: Caught exception in launch"):]
+
+    assert error(ours.stdout + ours.stderr) == error(theirs.stdout + theirs.stderr)
+    assert "NameError: name 'undefined_action' is not defined" in ours.stdout
