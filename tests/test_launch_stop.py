@@ -197,3 +197,31 @@ def test_the_live_view_on_a_terminal_shows_each_process(demo, tmp_path: Path) ->
         os.close(terminal)
     assert os.waitstatus_to_exitcode(status) == 0
     _no_process_left(prefix)
+
+
+STUBBORN = """
+from launch import LaunchDescription
+from launch.actions import ExecuteProcess
+
+
+def generate_launch_description():
+    return LaunchDescription([ExecuteProcess(cmd=['sh', '{script}'], output='screen')])
+"""
+
+
+def test_a_second_ctrl_c_kills_every_process_at_once(demo, tmp_path: Path) -> None:
+    env, _ = demo
+    script = tmp_path / "stubborn.sh"  # ignores SIGINT: the library would wait 5 s before its SIGTERM
+    script.write_text("trap '' INT\necho ready\nwhile true; do sleep 1; done\n")
+    (tmp_path / "stubborn.launch.py").write_text(STUBBORN.format(script=script))
+    launcher = roc_launch(str(tmp_path / "stubborn.launch.py"), env=env, log=tmp_path / "roc.log")
+    try:
+        launcher.wait_for_output("[sh-1] ready")
+        launcher.process.send_signal(signal.SIGINT)
+        launcher.wait_for_output("[INFO] [sh-1]: sending signal 'SIGINT' to process[sh-1]")
+        started = time.monotonic()
+    finally:
+        code = launcher.stop(signal.SIGINT, timeout=10)
+    assert code == 130 and time.monotonic() - started < 4
+    assert "[WARNING] [roc]: SIGINT again, killing every process now" in launcher.output()
+    assert processes_with(str(tmp_path)) == []

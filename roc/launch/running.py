@@ -13,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from roc.errors import EXIT_INTERRUPTED
 from roc.launch.check import CheckOptions
 from roc.launch.guard import Guard
 from roc.launch.monitor import Monitor
@@ -49,6 +50,7 @@ class Running:
             self.output = self.monitor.output = LiveView(self.monitor.snapshot, options.title)
         self.stopping = threading.Event()
         self.check_passed: bool | None = None  # None: not checked (yet)
+        self.killed = False  # a second signal killed every process
         self._check_thread: threading.Thread | None = None
         self._previous: dict[int, object] = {}
 
@@ -63,6 +65,7 @@ class Running:
         def on_signal(signum: int, _frame) -> None:
             if self.stopping.is_set():
                 self.monitor.note(f"[WARNING] [roc]: {signal.Signals(signum).name} again, killing every process now")
+                self.killed = True
                 self.guard.close(grace=0.0)
                 return
             self.stopping.set()
@@ -102,7 +105,12 @@ class Running:
         self._check_thread.start()
 
     def exit_code(self, code: int) -> int:
-        """With ``--exit-after-check``, the check decides (1 when it failed or never ran)."""
+        """130 when a second signal killed the run; with ``--exit-after-check``, the check decides (1 when
+        it failed or never ran); 1 for a code that is a signal."""
+        if self.killed:
+            return EXIT_INTERRUPTED
+        if code < 0:
+            return 1
         if self.options.check is not None and self.options.check.exit_after:
             return 0 if self.check_passed and code == 0 else 1
         return code
