@@ -108,7 +108,9 @@ class Observer:
 
 def one_round(observer: Observer, command: list[str], env: dict[str, str]) -> float:
     if not observer.wait(lambda seen: not seen & NODES, 60):
-        raise SystemExit(f"the previous round's nodes are still in the graph: {sorted(observer.seen() & NODES)}")
+        alive = subprocess.run(["pgrep", "-af", str(WORK / "install")], capture_output=True, text=True).stdout
+        raise SystemExit(f"the previous round's nodes are still in the graph: {sorted(observer.seen() & NODES)}; "
+                         f"processes: {alive or 'none'}")
     start = time.perf_counter()
     launcher = subprocess.Popen(command, cwd=WORK, env=env, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL)
@@ -117,6 +119,7 @@ def one_round(observer: Observer, command: list[str], env: dict[str, str]) -> fl
             raise SystemExit(f"{command[:3]}: the ten nodes did not appear within 60 s")
         return time.perf_counter() - start
     finally:
+        time.sleep(1)  # every node past its start-up (a node interrupted while it starts may exit uncleanly)
         launcher.send_signal(signal.SIGINT)
         launcher.wait(timeout=60)
 

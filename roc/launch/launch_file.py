@@ -63,7 +63,6 @@ def launch(launch_file: LaunchFile, options: RunOptions) -> int:
             "debug": launch_file.debug, "events_fd": events_write,
             "log_dir": str(library_logs) if library_logs else None}
     extra = {"OVERRIDE_LAUNCH_PROCESS_OUTPUT": "both"} if launch_file.show_all_output else {}
-    relay = subprocess.PIPE if options.view else None
     runners: list[subprocess.Popen] = []
 
     def stop() -> None:
@@ -75,9 +74,11 @@ def launch(launch_file: LaunchFile, options: RunOptions) -> int:
 
     running.catch_signals(stop)  # first: no process may inherit an ignored SIGINT (a background job's)
     try:
-        runner = subprocess.Popen(_runner_command(spec), stdin=subprocess.DEVNULL, stdout=relay,
-                                  stderr=subprocess.STDOUT if options.view else None, pass_fds=(events_write,),
-                                  start_new_session=True, env=running.environment(extra))
+        # a process group of its own in roc's session: the terminal's signals reach roc alone, and the
+        # system shares the terminal session's CPU share (its autogroup), as under ros2 launch
+        runner = subprocess.Popen(_runner_command(spec), stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                  stderr=subprocess.STDOUT, pass_fds=(events_write,), process_group=0,
+                                  env=running.environment(extra))
     except BaseException:
         running.close()
         raise
@@ -91,7 +92,7 @@ def launch(launch_file: LaunchFile, options: RunOptions) -> int:
     started = threading.Event()  # the first process started
     settled = threading.Event()  # and no other started for SETTLE_SECONDS
     threads = [threading.Thread(target=_read_events, args=(events_read, running, started), daemon=True)]
-    if options.view and runner.stdout is not None:
+    if runner.stdout is not None:
         threads.append(threading.Thread(target=_relay, args=(runner.stdout, running), daemon=True))
     for thread in threads:
         thread.start()
@@ -140,7 +141,7 @@ def _settle(running: Running, started: threading.Event, settled: threading.Event
 
 
 def _relay(stream, running: Running) -> None:
-    """The runner's own output (ros2 launch's lines), printed above the live view."""
+    """The runner's own output (ros2 launch's lines), printed as it comes (above the live view)."""
     while True:
         data = os.read(stream.fileno(), 65536)
         if not data:

@@ -6,9 +6,10 @@ through the launch file, ``launch_ros`` and rclpy). It prints what ros2 launch p
 screen output) and reports each process's start, output and exit to roc as JSON lines on the file
 descriptor ``events_fd``.
 
-It runs in a session of its own (roc starts it so), so the terminal's Ctrl+C reaches roc alone: roc sends
-it one SIGINT, and the library, told it is non-interactive, passes SIGINT on to every process and
-escalates to SIGTERM and SIGKILL as ros2 launch does.
+It runs in a process group of its own (roc starts it so), so the terminal's Ctrl+C reaches roc alone: roc
+sends it one SIGINT, and the library, told it is non-interactive, passes SIGINT on to every process and
+escalates to SIGTERM and SIGKILL as ros2 launch does. Its output goes through roc, so it never writes to
+the terminal from a background process group.
 """
 
 from __future__ import annotations

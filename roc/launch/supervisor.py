@@ -1,5 +1,6 @@
-"""roc's own process supervisor, for the systems of roc.toml: starts a process (in a session of its own,
-so that only roc signals it), reads its output into the monitor, restarts it when it has ``respawn``, and
+"""roc's own process supervisor, for the systems of roc.toml: starts a process (in a process group of its
+own in roc's session: only roc signals it, and it shares the terminal session's CPU share as under ros2
+launch), reads its output into the monitor, restarts it when it has ``respawn``, and
 stops every process as ros2 launch does: SIGINT, then SIGTERM after 5 s, then SIGKILL after 5 s more."""
 
 from __future__ import annotations
@@ -51,7 +52,7 @@ class Supervisor:
     def _spawn(self, spec: ProcessSpec, command: list[str]) -> subprocess.Popen:
         try:
             process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                       stderr=subprocess.STDOUT, start_new_session=True,
+                                       stderr=subprocess.STDOUT, process_group=0,
                                        env=self.environment(spec.env))
         except OSError as error:
             raise TaskError(f"cannot run '{command[0]}': {error.strerror}") from None
