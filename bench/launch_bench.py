@@ -9,15 +9,18 @@ The system: ``ten.launch.py`` of the tests' package roc_launch_demo (workspaces/
 talkers at 1 Hz in namespace /bench), built by roc into bench/.work/launch_ws. Variants, interleaved in
 each round:
 
-- ``ros2 launch roc_launch_demo ten.launch.py`` (the oracle, from the tests' ros2cli venv);
-- ``roc launch roc_launch_demo ten.launch.py`` (the same file, the same launch library);
-- ``roc launch ten``: the same ten processes declared in roc.toml (roc's own supervisor, no launch library).
+- ``ros2 launch roc_launch_demo ten.launch.py namespace:=NS`` (the oracle, from the tests' ros2cli venv);
+- ``roc launch roc_launch_demo ten.launch.py namespace:=NS`` (the same file, the same launch library);
+- ``roc launch NS``: the same ten processes declared in roc.toml (roc's own supervisor, no launch library).
+
+Each start uses a namespace of its own (a node that left uncleanly can stay in the observer's graph for a
+while, which must not delay or fool the next round).
 
 The observer is an rclpy node of this process, in ROS domain 97 with localhost discovery, created before
 the rounds and using roc's Fast DDS participant profile (announcements every 0.5 s): with Fast DDS's 3 s a
 node whose first announcements the observer missed is seen up to 3 s late, noise that would swamp the
 launchers' difference (the launched processes keep Fast DDS's defaults). Each round starts once the
-observer sees none of the nodes. Times: median, min and max over the rounds; the ratio is of medians.
+launcher of the round before has ended. Times: median, min and max over the rounds; the ratio is of medians.
 
 Idle CPU: after the last round, each launcher (plain output, not a terminal) runs the system for a few
 seconds, then the CPU time of the launcher's own processes (roc: roc, its guard and, for a launch file,
@@ -44,16 +47,23 @@ from graph_helpers import ORACLE_VENV, install_oracle  # noqa: E402
 
 WORK = REPO / "bench" / ".work" / "launch_ws"
 DOMAIN = "97"
-NODES = {f"/bench/talker_{i}" for i in range(10)}
+
+def nodes(namespace: str) -> set[str]:
+    return {f"/{namespace}/talker_{i}" for i in range(10)}
 ROC = str(Path(sys.executable).parent / "roc")
 SITE = f"lib/python{sys.version_info.major}.{sys.version_info.minor}/site-packages"
-SYSTEM = "[launch.ten]\n" + "".join(
-    f'[[launch.ten.process]]\npackage = "roc_launch_demo"\nexecutable = "talker"\nname = "talker_{i}"\n'
-    f'namespace = "bench"\nparameters = {{ rate = 1.0 }}\n' for i in range(10))
 
 
-def build() -> Path:
-    """roc_launch_demo built by roc (again when the fixture changed); its install prefix."""
+def system(namespace: str) -> str:
+    """The ten talkers as a roc.toml system named after their namespace."""
+    return f"[launch.{namespace}]\n" + "".join(
+        f'[[launch.{namespace}.process]]\npackage = "roc_launch_demo"\nexecutable = "talker"\nname = "talker_{i}"\n'
+        f'namespace = "{namespace}"\nparameters = {{ rate = 1.0 }}\n' for i in range(10))
+
+
+def build(namespaces: list[str]) -> Path:
+    """roc_launch_demo built by roc (again when the fixture changed), and a roc.toml with one system per
+    namespace; its install prefix."""
     fixture = REPO / "workspaces" / "fixtures" / "launch"
     stamp = WORK / ".fixture"
     state = "".join(f"{p}:{p.stat().st_mtime_ns}\n" for p in sorted(fixture.rglob("*")) if p.is_file())
@@ -63,7 +73,7 @@ def build() -> Path:
         subprocess.run([ROC, "work", "build"], cwd=WORK, env={**os.environ, "AMENT_PREFIX_PATH": sys.prefix},
                        check=True, capture_output=True)
         stamp.write_text(state)
-    (WORK / "roc.toml").write_text(SYSTEM)
+    (WORK / "roc.toml").write_text("".join(system(namespace) for namespace in namespaces))
     return WORK / "install" / "roc_launch_demo"
 
 
@@ -76,10 +86,14 @@ def environment(prefix: Path) -> dict[str, str]:
     return env
 
 
+# Each start of a variant puts its nodes in a namespace of their own (a node that left uncleanly may stay in
+# the observer's graph for a while): the command for a namespace.
 VARIANTS = {
-    "ros2 launch (file)": [str(ORACLE_VENV / "bin" / "ros2"), "launch", "roc_launch_demo", "ten.launch.py"],
-    "roc launch (file)": [ROC, "launch", "--log-base", "/dev/null", "roc_launch_demo", "ten.launch.py"],
-    "roc launch (roc.toml)": [ROC, "launch", "--log-base", "/dev/null", "ten"],
+    "ros2 launch (file)": lambda ns: [str(ORACLE_VENV / "bin" / "ros2"), "launch", "roc_launch_demo", "ten.launch.py",
+                                      f"namespace:={ns}"],
+    "roc launch (file)": lambda ns: [ROC, "launch", "--log-base", "/dev/null", "roc_launch_demo", "ten.launch.py",
+                                     f"namespace:={ns}"],
+    "roc launch (roc.toml)": lambda ns: [ROC, "launch", "--log-base", "/dev/null", ns],
 }
 
 
@@ -106,16 +120,13 @@ class Observer:
         return True
 
 
-def one_round(observer: Observer, command: list[str], env: dict[str, str]) -> float:
-    if not observer.wait(lambda seen: not seen & NODES, 60):
-        alive = subprocess.run(["pgrep", "-af", str(WORK / "install")], capture_output=True, text=True).stdout
-        raise SystemExit(f"the previous round's nodes are still in the graph: {sorted(observer.seen() & NODES)}; "
-                         f"processes: {alive or 'none'}")
+def one_round(observer: Observer, name: str, namespace: str, env: dict[str, str]) -> float:
+    command, expected = VARIANTS[name](namespace), nodes(namespace)
     start = time.perf_counter()
     launcher = subprocess.Popen(command, cwd=WORK, env=env, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL)
     try:
-        if not observer.wait(lambda seen: NODES <= seen, 60):
+        if not observer.wait(lambda seen: expected <= seen, 60):
             raise SystemExit(f"{command[:3]}: the ten nodes did not appear within 60 s")
         return time.perf_counter() - start
     finally:
@@ -137,10 +148,12 @@ def launcher_processes(root: int) -> list[int]:
     return [p.pid for p in found]
 
 
-def idle_cpu(observer: Observer, command: list[str], env: dict[str, str], seconds: float, terminal: bool) -> float:
+def idle_cpu(observer: Observer, name: str, namespace: str, env: dict[str, str], seconds: float,
+             terminal: bool) -> float:
     """Percent of one core used by the launcher's own processes while the system runs."""
     import psutil
 
+    command, expected = VARIANTS[name](namespace), nodes(namespace)
     if terminal:
         pid, fd = pty.fork()
         if pid == 0:
@@ -153,7 +166,7 @@ def idle_cpu(observer: Observer, command: list[str], env: dict[str, str], second
                                     stderr=subprocess.DEVNULL)
         pid = launcher.pid
     try:
-        observer.wait(lambda seen: NODES <= seen, 60)
+        observer.wait(lambda seen: expected <= seen, 60)
         time.sleep(3)  # start-up is over
         processes = [psutil.Process(p) for p in launcher_processes(pid)]
 
@@ -171,7 +184,6 @@ def idle_cpu(observer: Observer, command: list[str], env: dict[str, str], second
             os.close(fd)
         else:
             launcher.wait(timeout=60)
-        observer.wait(lambda seen: not seen & NODES, 30)
 
 
 def main() -> int:
@@ -182,13 +194,15 @@ def main() -> int:
     reason = install_oracle(launch=True)
     if reason:
         raise SystemExit(f"ros2 launch is not available: {reason}")
-    env = environment(build())
+    namespaces = [f"{kind}{n}" for n in range(args.rounds) for kind in ("ros2_", "file_", "toml_")]
+    namespaces += ["idle_ros2", "idle_file", "idle_toml", "idle_view"]
+    env = environment(build(namespaces))
     observer = Observer()
     observer.wait(lambda _seen: False, 2)  # the observer joins the domain
     times: dict[str, list[float]] = {name: [] for name in VARIANTS}
     for round_number in range(args.rounds):
-        for name, command in VARIANTS.items():
-            times[name].append(one_round(observer, command, env))
+        for name, kind in zip(VARIANTS, ("ros2_", "file_", "toml_")):
+            times[name].append(one_round(observer, name, f"{kind}{round_number}", env))
         print(f"round {round_number + 1}: " + ", ".join(f"{n} {t[-1]:.2f} s" for n, t in times.items()), flush=True)
     oracle = statistics.median(times["ros2 launch (file)"])
     print(f"\ntime from the command to all 10 nodes visible ({args.rounds} rounds, interleaved)")
@@ -197,10 +211,10 @@ def main() -> int:
         median = statistics.median(values)
         print(f"{name:<24}{median:>8.2f}s{min(values):>7.2f}s{max(values):>7.2f}s{median / oracle:>8.2f}x")
     print(f"\nlauncher CPU while supervising the running system ({args.idle_seconds:g} s, % of one core)")
-    idle = [("ros2 launch (file)", False), ("roc launch (file)", False), ("roc launch (roc.toml)", False),
-            ("roc launch (file)", True)]
-    for name, terminal in idle:
-        percent = idle_cpu(observer, VARIANTS[name], env, args.idle_seconds, terminal)
+    idle = [("ros2 launch (file)", "idle_ros2", False), ("roc launch (file)", "idle_file", False),
+            ("roc launch (roc.toml)", "idle_toml", False), ("roc launch (file)", "idle_view", True)]
+    for name, namespace, terminal in idle:
+        percent = idle_cpu(observer, name, namespace, env, args.idle_seconds, terminal)
         print(f"{name + (', live view' if terminal else ''):<36}{percent:>6.2f} %", flush=True)
     return 0
 
