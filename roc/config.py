@@ -73,6 +73,31 @@ def key_line(text: str, start: int, key: str) -> int:
     return start
 
 
+def type_names(types: tuple[type, ...]) -> str:
+    """``a string``, ``an integer or a number``: what a value of ``types`` is, for messages."""
+    names = {bool: "true or false", int: "an integer", float: "a number", str: "a string", list: "a list",
+             dict: "a table"}
+    return " or ".join(dict.fromkeys(names[t] for t in types))
+
+
+def check_table(path: Path, text: str, start: int, table: dict, schema: dict[str, tuple[tuple[type, ...], bool]],
+                where: str) -> None:
+    """Every key of ``table`` (whose header is on line ``start`` of ``text``) is in ``schema`` ({key:
+    (accepted types, required)}) with a value of its types, and every required key is there; else a
+    ConfigError naming the file, the line and the key. ``where`` names the table, e.g. ``[[check.topic]]``."""
+    for key, value in table.items():
+        line = key_line(text, start, key)
+        if key not in schema:
+            hint = _closest(key, schema)
+            raise ConfigError(path, key, f"unknown key of {where}; {hint}use {', '.join(schema)}", line)
+        types, _ = schema[key]
+        if not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
+            raise ConfigError(path, key, f"expected {type_names(types)}, got {value!r}", line)
+    for key, (_, required) in schema.items():
+        if required and key not in table:
+            raise ConfigError(path, key, f"missing in {where}", start)
+
+
 class Setting:
     """One configured value and where it came from."""
 

@@ -188,7 +188,7 @@ min-rate = 3
 
 @pytest.mark.parametrize("text, error", [
     ('[launch.x]\n[[launch.x.process]]\npakage = "a"\n',
-     "roc.toml:3: 'pakage': unknown key of a process; did you mean 'package'?"),
+     "roc.toml:3: 'pakage': unknown key of [[launch.x.process]]; did you mean 'package'? use package, "),
     ('[launch.x]\n[[launch.x.process]]\npackage = "a"\nexecutable = "b"\n'
      '[[launch.x.process]]\npackage = "a"\nexecutable = "c"\nafter = ["service /x is up"]\n',
      "roc.toml:8: 'after': cannot read the condition 'service /x is up'; write one of 'node NAME exists', "),

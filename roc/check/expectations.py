@@ -44,7 +44,7 @@ from typing import Any
 
 import tomllib
 
-from roc.config import ROC_TOML, ConfigError, header_lines, key_line
+from roc.config import ROC_TOML, ConfigError, check_table, header_lines, key_line, type_names
 from roc.errors import UsageError
 from roc.messages import did_you_mean
 
@@ -87,12 +87,6 @@ class CheckFile:
     rate_window: float = 2.0
 
 
-def _type_names(types: tuple[type, ...]) -> str:
-    names = {bool: "true or false", int: "an integer", float: "a number", str: "a string", list: "a list",
-             dict: "a table"}
-    return " or ".join(dict.fromkeys(names[t] for t in types))
-
-
 def load_checks(path: Path) -> CheckFile:
     """The expectations of the ``[check]`` table of ``path``."""
     try:
@@ -117,7 +111,7 @@ def load_checks(path: Path) -> CheckFile:
             raise ConfigError(path, key, f"unknown key of [check]; {hint + ' ' if hint else ''}use "
                               f"{', '.join(SETTINGS)} or [[check.{']], [[check.'.join(SCHEMA)}]]", line)
         if not isinstance(value, SETTINGS[key]) or isinstance(value, bool):
-            raise ConfigError(path, key, f"expected {_type_names(SETTINGS[key])}, got {value!r}", line)
+            raise ConfigError(path, key, f"expected {type_names(SETTINGS[key])}, got {value!r}", line)
     checks.timeout = float(table.get("timeout", checks.timeout))
     checks.rate_window = float(table.get("rate-window", checks.rate_window))
     for node in table.get("nodes", []):
@@ -144,20 +138,11 @@ def load_checks(path: Path) -> CheckFile:
 
 
 def _expectation(path: Path, text: str, kind: str, schema: dict, entry: dict, start: int) -> Expectation:
-    for key, value in entry.items():
-        line = key_line(text, start, key)
-        if key not in schema:
-            hint = did_you_mean(key, schema, count=1)
-            raise ConfigError(path, key, f"unknown key of [[check.{kind}]]; {hint + ' ' if hint else ''}use "
-                              f"{', '.join(schema)}", line)
-        types, _ = schema[key]
-        if not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
-            raise ConfigError(path, key, f"expected {_type_names(types)}, got {value!r}", line)
-        if key in POLICIES and value not in POLICIES[key]:
-            raise ConfigError(path, key, f"expected {' or '.join(POLICIES[key])}, got {value!r}", line)
-    for key, (_, required) in schema.items():
-        if required and key not in entry:
-            raise ConfigError(path, key, f"missing in [[check.{kind}]]", start)
+    check_table(path, text, start, entry, schema, f"[[check.{kind}]]")
+    for key in POLICIES.keys() & entry.keys():
+        if entry[key] not in POLICIES[key]:
+            raise ConfigError(path, key, f"expected {' or '.join(POLICIES[key])}, got {entry[key]!r}",
+                              key_line(text, start, key))
     return Expectation(kind, entry["name"], {k: v for k, v in entry.items() if k != "name"}, f"{path}:{start}")
 
 

@@ -39,7 +39,7 @@ from typing import Any
 import tomllib
 
 from roc.check.expectations import Expectation
-from roc.config import ROC_TOML, ConfigError, header_lines, key_line
+from roc.config import ROC_TOML, ConfigError, check_table, header_lines, key_line
 from roc.errors import UsageError
 from roc.messages import did_you_mean
 
@@ -162,12 +162,6 @@ def load_system(path: Path, name: str) -> System:
     return System(name, path, processes, timeout)
 
 
-def _type_names(types: tuple[type, ...]) -> str:
-    names = {bool: "true or false", int: "a number", float: "a number", str: "a string", list: "a list",
-             dict: "a table"}
-    return " or ".join(dict.fromkeys(names[t] for t in types))
-
-
 def _flatten(table: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     flat: dict[str, Any] = {}
     for key, value in table.items():
@@ -182,23 +176,13 @@ def _process(path: Path, text: str, entry: Any, start: int, system: str) -> Proc
     if not isinstance(entry, dict):
         raise ConfigError(path, f"launch.{system}.process", "write each process as a [[launch.NAME.process]] table",
                           start)
-    for key, value in entry.items():
-        line = key_line(text, start, key)
-        if key not in PROCESS_KEYS:
-            hint = did_you_mean(key, PROCESS_KEYS, count=1)
-            raise ConfigError(path, key, f"unknown key of a process; {hint + ' ' if hint else ''}use "
-                              f"{', '.join(PROCESS_KEYS)}", line)
-        types, _ = PROCESS_KEYS[key]
-        if not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
-            raise ConfigError(path, key, f"expected {_type_names(types)}, got {value!r}", line)
-        given: Any = entry[key]  # its type checked above
-        if key in ("remappings", "env") and not all(isinstance(v, str) for v in given.values()):
-            raise ConfigError(path, key, "expected a table of strings", line)
-        if key in ("arguments", "after") and not all(isinstance(v, str) for v in given):
-            raise ConfigError(path, key, "expected a list of strings", line)
-    for key, (_, required) in PROCESS_KEYS.items():
-        if required and key not in entry:
-            raise ConfigError(path, key, f"missing in [[launch.{system}.process]]", start)
+    check_table(path, text, start, entry, PROCESS_KEYS, f"[[launch.{system}.process]]")
+    for key in ("remappings", "env"):
+        if not all(isinstance(v, str) for v in entry.get(key, {}).values()):
+            raise ConfigError(path, key, "expected a table of strings", key_line(text, start, key))
+    for key in ("arguments", "after"):
+        if not all(isinstance(v, str) for v in entry.get(key, [])):
+            raise ConfigError(path, key, "expected a list of strings", key_line(text, start, key))
     name, namespace = entry.get("name", ""), entry.get("namespace", "")
     if namespace and not namespace.startswith("/"):
         namespace = f"/{namespace}"
