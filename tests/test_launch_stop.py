@@ -101,10 +101,30 @@ def test_a_failing_process_is_reported_and_restarted_only_with_respawn(demo, tmp
     starts = output.count("[INFO] [crasher-2]: process started")
     assert starts >= 3 if respawn else starts == 1, output
     assert "exit code 3, cmd '" in output
+    assert '[args-3] ["printed", ' not in output  # its output is 'log': stdout in its log file only
+    assert '["printed", "--ros-args"' in (tmp_path / "log" / "latest_launch" / "args-3.log").read_text()
     log = (tmp_path / "log" / "latest_launch" / "crasher-2.log").read_text()
     assert log.count("[roc] ") >= 2 * min(starts, 3)  # each start and each exit
     assert "[ERROR] [" in log and "failing with exit code 3" in log
     assert (tmp_path / "log" / "latest_launch" / "launch" / "launch.log").is_file()  # the library's own log
+
+
+@pytest.mark.slow
+def test_launch_prefix_its_filter_and_all_output_as_in_ros2_launch(demo, tmp_path: Path) -> None:
+    import re
+
+    env, prefix = demo
+    launcher = roc_launch("-a", "--launch-prefix", "env ROC_PREFIXED=yes", "--launch-prefix-filter", "talker",
+                          PACKAGE, "crash.launch.py", env=env, log=tmp_path / "roc.log")
+    try:
+        output = launcher.wait_for_output('[args-3] ["printed", ')  # shown although its output is 'log'
+        talker = int(re.search(r"\[INFO\] \[env-1\]: process started with pid \[(\d+)\]", output)[1])  # named after env
+        assert b"ROC_PREFIXED=yes" in Path(f"/proc/{talker}/environ").read_bytes().split(b"\0")
+        died = launcher.wait_for_output("[ERROR] [crasher-2]: process has died")
+        assert re.search(r"process has died \[pid \d+, exit code 3, cmd '/\S+/crasher ", died)  # no prefix
+    finally:
+        assert launcher.stop() == 0
+    _no_process_left(prefix)
 
 
 CHECK_GREEN = """
