@@ -19,6 +19,17 @@ SITE = f"lib/python{sys.version_info.major}.{sys.version_info.minor}/site-packag
 DEMO_NODES = {"/robot1/talker", "/robot1/listener", "/map_server"}
 
 
+def skip_without_launch_library() -> None:
+    """Launch files need the ROS 2 launch library in roc's venv (scripts/setup.sh installs it from
+    ../shared/oracles when that exists)."""
+    import importlib.util
+
+    import pytest
+
+    if importlib.util.find_spec("launch_ros") is None:
+        pytest.skip("the ROS 2 launch library is not installed in this venv (see scripts/setup.sh)")
+
+
 def build_demo(directory: Path) -> Path:
     """roc_launch_demo built by roc in a copy of the fixture workspace; its install prefix."""
     import shutil

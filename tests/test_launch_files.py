@@ -16,6 +16,7 @@ from launch_helpers import (
     nodes,
     roc_launch,
     ros2_launch,
+    skip_without_launch_library,
     wait_for_nodes,
     wait_until,
 )
@@ -27,6 +28,7 @@ NODES = {"/r7/talker", "/r7/listener", "/map_server"}
 
 @pytest.fixture(scope="module")
 def demo(tmp_path_factory, launch_demo_prefix):
+    skip_without_launch_library()
     reason = install_oracle(launch=True)
     if reason:
         pytest.skip(f"no ros2 launch oracle: {reason}")

@@ -19,6 +19,7 @@ from launch_helpers import (
     processes_with,
     roc_launch,
     ros2_launch,
+    skip_without_launch_library,
     wait_for_nodes,
     wait_until,
 )
@@ -28,6 +29,7 @@ PACKAGE = "roc_launch_demo"
 
 @pytest.fixture(scope="module")
 def demo(tmp_path_factory, launch_demo_prefix):
+    skip_without_launch_library()
     prefix = launch_demo_prefix
     env = demo_env(30, tmp_path_factory.mktemp("runtime"), prefix)
     yield env, prefix
