@@ -162,7 +162,7 @@ def test_the_monitor_prints_as_ros2_launch_and_keeps_each_process_row(tmp_path: 
     monitor.output_text("a", " halves\n\n")
     monitor.exited("a", 11, 3, ["/bin/a", "--x"])
     monitor.started("a", 12, ["/bin/a", "--x"])
-    monitor.stopping = True
+    monitor.stopping.set()
     monitor.exited("a", 12, -2, ["/bin/a", "--x"])
     monitor.close()
     assert output.lines == [

@@ -103,7 +103,7 @@ def launch(launch_file: LaunchFile, options: RunOptions) -> int:
         code = runner.wait()
     finally:
         settled.set()
-        running.monitor.stopping = True
+        running.stopping.set()
         for thread in threads:
             thread.join(timeout=5.0)
         running.close()

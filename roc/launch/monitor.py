@@ -49,7 +49,7 @@ class Monitor:
     log_directory: Path | None = None
     echo: bool = True
     rows: dict[str, ProcessRow] = field(default_factory=dict)
-    stopping: bool = False  # exits from now on are stops, not failures
+    stopping: threading.Event = field(default_factory=threading.Event)  # set: the run is ending, exits are stops
     last_start: float = 0.0  # time.monotonic() of the last process start
 
     def __post_init__(self) -> None:
@@ -111,7 +111,7 @@ class Monitor:
             row.code = code
             if code == 0:
                 row.state, row.detail = "exited", "exit code 0"
-            elif self.stopping:
+            elif self.stopping.is_set():
                 row.state, row.detail = "stopped", f"exit code {code}"
             else:
                 row.state, row.detail = "failed", f"exit code {code}"

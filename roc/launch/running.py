@@ -44,11 +44,11 @@ class Running:
 
             self.log_directory = new_log_directory(options.log_base.absolute(), "launch")
         self.guard = Guard()
-        self.output: LiveView | PlainOutput = PlainOutput()
-        self.monitor = Monitor(self.output, self.log_directory, echo)
-        if options.view:
-            self.output = self.monitor.output = LiveView(self.monitor.snapshot, options.title)
-        self.stopping = threading.Event()
+        plain = PlainOutput()
+        self.monitor = Monitor(plain, self.log_directory, echo)
+        self.output: LiveView | PlainOutput = LiveView(self.monitor.snapshot, options.title) if options.view else plain
+        self.monitor.output = self.output
+        self.stopping = self.monitor.stopping  # set by the first signal, or when the run ends
         self.check_passed: bool | None = None  # None: not checked (yet)
         self.killed = False  # a second signal killed every process
         self._check_thread: threading.Thread | None = None
@@ -69,7 +69,6 @@ class Running:
                 self.guard.close(grace=0.0)
                 return
             self.stopping.set()
-            self.monitor.stopping = True
             stop()
 
         self._previous = {signum: signal.signal(signum, on_signal) for signum in STOP_SIGNALS}
@@ -98,7 +97,6 @@ class Running:
                                   f"{'every expectation holds' if self.check_passed else 'expectations failed'}, "
                                   "stopping")
                 self.stopping.set()
-                self.monitor.stopping = True
                 request_stop()
 
         self._check_thread = threading.Thread(target=check, name="roc-check", daemon=True)

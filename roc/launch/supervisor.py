@@ -32,7 +32,7 @@ class Supervisor:
         self.monitor = monitor
         self.environment = environment  # a process's extra variables -> its whole environment
         self.record = record  # tells the orphan guard about each process started
-        self.stopping = threading.Event()
+        self.stopping = monitor.stopping  # set: no more restarts, and exits are no failures
         self.failed: list[str] = []  # processes that ended with an error (and are not restarted)
         self._lock = threading.Lock()
         self._running: dict[str, subprocess.Popen] = {}

@@ -61,7 +61,6 @@ def launch_system(system: System, options: RunOptions, use_daemon: bool, spin_ti
     finally:
         settled.set()
         running.stopping.set()
-        running.monitor.stopping = True
         supervisor.stop()
         running.close()
     return running.exit_code(0 if ok and not supervisor.failed else 1)
