@@ -1,7 +1,8 @@
 """One probe per expectation: it asks the graph (through a roc.ros.client.Session, shared by all
 probes) and says pass or fail with what it measured and what was expected. A probe that cannot ask
 (the graph layer fails, a time limit passes) is an error. Probes run as ``probe`` tasks of roc's
-engine (roc.commands.graph.check)."""
+engine (``probe_task``): for roc graph check, roc launch --check, and the conditions of roc.toml's launch
+systems, which probe again until the condition holds (``probe_until``)."""
 
 from __future__ import annotations
 
