@@ -81,8 +81,8 @@ def test_a_missing_launch_library_is_one_line_saying_how_to_get_it(monkeypatch) 
     with pytest.raises(RocError) as raised:
         require_launch_library()
     assert str(raised.value) == (f"the ROS 2 launch library (launch, launch_ros) is not installed for "
-                                 f"{sys.executable}: source your ROS 2 installation (e.g. /opt/ros/jazzy/setup.bash) or install "
-                                 "ros-<distro>-launch-ros, then run roc launch again")
+                                 f"{sys.executable}: source your ROS 2 installation (e.g. /opt/ros/jazzy/setup.bash) "
+                                 "or install ros-<distro>-launch-ros, then run roc launch again")
 
 
 def _alive(pid: int) -> bool:
