@@ -55,6 +55,50 @@ def _line_of(text: str, table: str, key: str) -> int | None:
     return None
 
 
+def header_lines(text: str, name: str) -> list[int]:
+    """The lines of every ``[name]`` or ``[[name]]`` header (a dotted name, parts maybe quoted), in order."""
+    dotted = r"\s*\.\s*".join(rf'"?{re.escape(part)}"?' for part in name.split("."))
+    pattern = re.compile(rf"^\s*\[\[?\s*{dotted}\s*\]")
+    return [number for number, line in enumerate(text.splitlines(), 1) if pattern.match(line)]
+
+
+def key_line(text: str, start: int, key: str) -> int:
+    """The line of ``key`` in the table whose header is on line ``start`` (the header's line if absent)."""
+    lines = text.splitlines()
+    for number in range(start + 1, len(lines) + 1):
+        line = lines[number - 1]
+        if line.lstrip().startswith("["):
+            break
+        if re.match(rf'\s*"?{re.escape(key)}"?\s*=', line):
+            return number
+    return start
+
+
+def type_names(types: tuple[type, ...]) -> str:
+    """``a string``, ``an integer or a number``: what a value of ``types`` is, for messages."""
+    names = {bool: "true or false", int: "an integer", float: "a number", str: "a string", list: "a list",
+             dict: "a table"}
+    return " or ".join(dict.fromkeys(names[t] for t in types))
+
+
+def check_table(path: Path, text: str, start: int, table: dict, schema: dict[str, tuple[tuple[type, ...], bool]],
+                where: str) -> None:
+    """Every key of ``table`` (whose header is on line ``start`` of ``text``) is in ``schema`` ({key:
+    (accepted types, required)}) with a value of its types, and every required key is there; else a
+    ConfigError naming the file, the line and the key. ``where`` names the table, e.g. ``[[check.topic]]``."""
+    for key, value in table.items():
+        line = key_line(text, start, key)
+        if key not in schema:
+            hint = _closest(key, schema)
+            raise ConfigError(path, key, f"unknown key of {where}; {hint}use {', '.join(schema)}", line)
+        types, _ = schema[key]
+        if not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
+            raise ConfigError(path, key, f"expected {type_names(types)}, got {value!r}", line)
+    for key, (_, required) in schema.items():
+        if required and key not in table:
+            raise ConfigError(path, key, f"missing in {where}", start)
+
+
 class Setting:
     """One configured value and where it came from."""
 
@@ -243,11 +287,13 @@ def _load_roc_toml(config: Configuration, path: Path, verb: str, profile: str | 
             raise UsageError(f"{path}:{len(lines)}:{len(lines[-1]) + 1}: invalid TOML: "
                              f"{str(error).split(' (at ')[0]} (at the end of the file)") from None
         raise UsageError(f"{path}: invalid TOML: {error}") from None
-    known_tables = {"defaults", "profile", "package", "check", *VERBS}  # [check]: roc.check.expectations
+    # [check]: roc.check.expectations; [launch.NAME]: roc.launch.system
+    known_tables = {"defaults", "profile", "package", "check", "launch", *VERBS}
     for table, values in data.items():
         if table not in known_tables or not isinstance(values, dict):
-            raise ConfigError(path, table, f"unknown table; {_closest(table, known_tables)}use [defaults], [{'], ['.join(VERBS)}], "
-                                           "[profile.NAME], [package.NAME]", _line_of(text, table, table) or
+            raise ConfigError(path, table, f"unknown table; {_closest(table, known_tables)}use [defaults], "
+                                           f"[{'], ['.join(VERBS)}], [profile.NAME], [package.NAME], [check], "
+                                           "[launch.NAME]", _line_of(text, table, table) or
                               next((n for n, line in enumerate(text.splitlines(), 1) if f"[{table}" in line), None))
     config.add_layer(data.get("defaults", {}), f"{ROC_TOML} [defaults]", path, "defaults", text)
     config.add_layer(data.get(verb, {}), f"{ROC_TOML} [{verb}]", path, verb, text)

@@ -130,13 +130,15 @@ pip_q install -q --no-warn-conflicts --upgrade --target "$VENV/oracle-setuptools
 # ---- fix-ups of the wheels' CMake files ---------------------------------------------------
 "$VPY" "$ROOT/scripts/fix_ros_wheels.py"
 
-# ---- composition_interfaces (no wheel): built from the shared oracle sources, with the real launch system
-# (launch_ros imports it), for roc component's tests. Skipped when the sources are not beside the checkout.
-ORACLES="$ROOT/../shared/oracles"
-if [ -f "$ORACLES/install_launch.sh" ] && ! "$VPY" -c 'import composition_interfaces.srv' >/dev/null 2>&1; then
-    say "building composition_interfaces and installing the launch system ($ORACLES/install_launch.sh)"
-    bash "$ORACLES/install_launch.sh" "$VENV" >"$VENV/install_launch.log" 2>&1 \
-        || { tail -20 "$VENV/install_launch.log" >&2; die "$ORACLES/install_launch.sh failed (log: $VENV/install_launch.log)"; }
+# ---- the ROS 2 launch system (launch, launch_xml, launch_yaml, launch_ros) and composition_interfaces ----
+# Not on PyPI: for roc launch's and roc component's tests and development they come from the shared
+# oracles' installer (which builds composition_interfaces from source), when it is beside the checkout.
+# Users get them from their ROS 2 installation.
+LAUNCH_INSTALLER="$ROOT/../shared/oracles/install_launch.sh"
+if [ -f "$LAUNCH_INSTALLER" ] && ! "$VPY" -c 'import launch, launch_ros, composition_interfaces.srv' >/dev/null 2>&1; then
+    say "installing the ROS 2 launch system and building composition_interfaces ($LAUNCH_INSTALLER)"
+    bash "$LAUNCH_INSTALLER" "$VENV" >"$VENV/install_launch.log" 2>&1 \
+        || { tail -20 "$VENV/install_launch.log" >&2; die "$LAUNCH_INSTALLER failed (log: $VENV/install_launch.log)"; }
 fi
 
 # ---- byte-code, as a pip install writes it (PYTHONDONTWRITEBYTECODE=1 may be set machine-wide,

@@ -28,3 +28,11 @@ def pytest_terminal_summary(terminalreporter) -> None:
         terminalreporter.section("missing oracles")
         for reason, count in missing:
             terminalreporter.write_line(f"{count} test{'s' if count != 1 else ''} skipped: {reason}")
+
+
+@pytest.fixture(scope="session")
+def launch_demo_prefix(tmp_path_factory):
+    """roc_launch_demo (workspaces/fixtures/launch) built by roc once per test worker: its install prefix."""
+    from launch_helpers import build_demo
+
+    return build_demo(tmp_path_factory.mktemp("launch_demo"))

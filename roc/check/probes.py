@@ -1,16 +1,20 @@
 """One probe per expectation: it asks the graph (through a roc.ros.client.Session, shared by all
 probes) and says pass or fail with what it measured and what was expected. A probe that cannot ask
 (the graph layer fails, a time limit passes) is an error. Probes run as ``probe`` tasks of roc's
-engine (roc.commands.graph.check)."""
+engine (``probe_task``): for roc graph check, roc launch --check, and the conditions of roc.toml's launch
+systems, which probe again until the condition holds (``probe_until``)."""
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TextIO
 
 from roc.check.expectations import Expectation
+from roc.engine.events import Event, ProbeResult
+from roc.engine.process import TaskCancelled, TaskContext, TaskError
+from roc.engine.ready import Task
 from roc.errors import RocError
 from roc.render import to_yaml_line
 from roc.ros.present import is_hidden, qos_problems
@@ -41,6 +45,55 @@ def probe(expectation: Expectation, session, timeout: float, rate_window: float)
     except RocError as error:
         return Verdict("error", str(error))
     return Verdict("pass", message, measured)
+
+
+KIND = "probe"  # the engine's kind of a probe task
+RETRY_SECONDS = 0.25
+
+
+def probe_until(expectation: Expectation, session, timeout: float, rate_window: float, wait: float,
+                stopped: Callable[[], bool] = lambda: False) -> Verdict:
+    """Probe again until the expectation holds or ``wait`` seconds have passed (a system coming up):
+    the last verdict. Raises TaskCancelled once ``stopped`` says so."""
+    deadline = time.monotonic() + wait
+    while True:
+        verdict = probe(expectation, session, timeout, rate_window)
+        if verdict.status == "pass" or time.monotonic() >= deadline:
+            return verdict
+        if stopped():
+            raise TaskCancelled
+        time.sleep(RETRY_SECONDS)
+
+
+def probe_task(expectation: Expectation, session, timeout: float, rate_window: float, wait: float = 0.0,
+               stopped: Callable[[], bool] = lambda: False) -> Task:
+    """One engine task of kind ``probe``: it emits the ProbeResult, and fails unless the probe passed
+    (within ``wait`` seconds, probing again and again until it passes or ``stopped`` says so)."""
+
+    def action(context: TaskContext) -> None:
+        verdict = probe_until(expectation, session, timeout, rate_window, wait,
+                              lambda: context.cancelled or stopped())
+        context.emit(ProbeResult(expectation.label, KIND, status=verdict.status, message=verdict.message,
+                                 expected=expectation.values, measured=verdict.measured))
+        if verdict.status != "pass":
+            raise TaskError(f"{verdict.status}: {verdict.message} ({expectation.where})")
+
+    return Task(name=expectation.label, dependencies=set(), action=action, kind=KIND)
+
+
+def probe_console(stream: TextIO) -> list[Callable[[Event], None]]:
+    """The handlers that print probe tasks as ``roc graph check`` does: each probe's line with what it
+    found, and the summary."""
+    from roc.handlers.console import ConsoleHandler
+
+    found: dict[str, str] = {}
+
+    def remember(event: Event) -> None:
+        if isinstance(event, ProbeResult):
+            found[event.key] = event.message
+
+    return [remember, ConsoleHandler(stream, kind=KIND, noun="probe", cached_label="",
+                                     finished_note=lambda key: f"  {found.get(key, '')}")]
 
 
 def _snapshot(session) -> dict[str, Any]:

@@ -10,9 +10,9 @@ import re
 from collections.abc import Mapping
 from pathlib import Path
 
+from roc.ament_index import resources
 from roc.doctor.findings import Finding
 from roc.environment import ament_prefixes, path_list
-from roc.ros.interfaces import resource_prefixes
 
 CATEGORY = "environment"
 DEFAULT_RMW = "rmw_fastrtps_cpp"
@@ -27,7 +27,7 @@ SHOWN = 5  # names listed in one finding
 
 def package_version(package: str) -> str | None:
     """The version in an installed package's package.xml, None when it is not installed."""
-    prefix = resource_prefixes("packages").get(package)
+    prefix = resources("packages").get(package)
     manifest = prefix / "share" / package / "package.xml" if prefix else None
     if manifest is None or not manifest.is_file():
         return None
@@ -56,7 +56,7 @@ def distribution(env: Mapping[str, str]) -> Finding:
 
 
 def installed_middlewares() -> list[str]:
-    return sorted(name for name in resource_prefixes("rmw_typesupport") if name != "rmw_implementation")
+    return sorted(name for name in resources("rmw_typesupport") if name != "rmw_implementation")
 
 
 def middleware(env: Mapping[str, str]) -> Finding:

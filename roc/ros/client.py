@@ -152,8 +152,10 @@ def start_daemon() -> Connection:
         import subprocess
 
         log = open(path.with_suffix(".log"), "ab")
+        # not one of a roc launch's processes, even when one of them starts it (roc/launch/guard.py's token)
+        env = {name: value for name, value in os.environ.items() if name != "ROC_LAUNCH_ID"}
         subprocess.Popen([sys.executable, "-m", "roc.ros.daemon", str(path)], stdin=subprocess.DEVNULL,
-                         stdout=log, stderr=log, process_group=0, close_fds=True)
+                         stdout=log, stderr=log, process_group=0, close_fds=True, env=env)
         log.close()
         deadline = time.monotonic() + START_TIMEOUT
         while time.monotonic() < deadline:

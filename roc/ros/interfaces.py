@@ -8,7 +8,7 @@ import re
 from collections.abc import Callable
 from pathlib import Path
 
-from roc.environment import ament_prefixes
+from roc.ament_index import resources
 from roc.errors import RocError
 from roc.messages import did_you_mean
 from roc.ros.types import TypeNameError
@@ -19,47 +19,21 @@ PRIMITIVES = {"bool", "byte", "char", "float32", "float64", "int8", "uint8", "in
 SEPARATOR = "---"
 
 
-def _resources(kind: str) -> dict[str, Path]:
-    """Resource name -> the first prefix that registers it (earlier prefixes overlay later ones)."""
-    found: dict[str, Path] = {}
-    for prefix in ament_prefixes():
-        directory = prefix / "share" / "ament_index" / "resource_index" / kind
-        if directory.is_dir():
-            for entry in directory.iterdir():
-                if not entry.name.startswith("."):
-                    found.setdefault(entry.name, prefix)
-    return found
-
-
-def resource_prefixes(kind: str) -> dict[str, Path]:
-    """{name: prefix} of the ament index's resources of ``kind`` (e.g. ``packages``,
-    ``rclcpp_components``), the first prefix of AMENT_PREFIX_PATH that registers a name winning."""
-    return _resources(kind)
-
-
-def resource_text(kind: str, name: str) -> str | None:
-    """The content of resource ``name`` of ``kind``, None when no prefix registers it."""
-    prefix = _resources(kind).get(name)
-    if prefix is None:
-        return None
-    return (prefix / "share" / "ament_index" / "resource_index" / kind / name).read_text()
-
-
 def interface_packages() -> list[str]:
-    return sorted(_resources("rosidl_interfaces"))
+    return sorted(resources("rosidl_interfaces"))
 
 
 def package_share(package: str) -> Path | None:
     """``share/<package>`` of the first prefix that registers the package, or None."""
-    prefix = _resources("packages").get(package)
+    prefix = resources("packages").get(package)
     return prefix / "share" / package if prefix is not None else None
 
 
 def package_interfaces(package: str | None = None) -> dict[str, dict[str, list[str]]]:
     """{package: {"msg": [names], "srv": [...], "action": [...]}}, hidden ones (with '_') left out."""
-    registered = _resources("rosidl_interfaces")
+    registered = resources("rosidl_interfaces")
     if package is not None:
-        if package not in _resources("packages"):
+        if package not in resources("packages"):
             raise RocError(f"Unknown package '{package}'")
         registered = {package: registered[package]} if package in registered else {}
     result = {}
@@ -79,7 +53,7 @@ def definition_path(type_name: str) -> Path:
     parts = type_name.split("/")
     if len(parts) != 3 or not all(parts) or ".." in parts:
         raise TypeNameError(f"Invalid name '{type_name}'. Expected three parts separated by '/'")
-    prefix = _resources("packages").get(parts[0])
+    prefix = resources("packages").get(parts[0])
     if prefix is None:
         raise RocError(f"Unknown package '{parts[0]}'")
     path = prefix / "share" / type_name

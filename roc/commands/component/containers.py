@@ -7,10 +7,10 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from roc.ament_index import resource_text, resources
 from roc.commands.node_services import SERVICE_TIMEOUT, call, node_is_hidden, services_of_type
 from roc.errors import RocError
 from roc.ros.client import Session
-from roc.ros.interfaces import resource_prefixes, resource_text
 
 RESOURCE = "rclcpp_components"
 CONTAINER_SERVICES = {"_container/load_node": "composition_interfaces/srv/LoadNode",
@@ -27,7 +27,7 @@ def component_types(package: str) -> list[str]:
 
 
 def packages_with_components() -> list[str]:
-    return sorted(resource_prefixes(RESOURCE))
+    return sorted(resources(RESOURCE))
 
 
 def containers(opened: Session) -> list[str]:

@@ -12,12 +12,12 @@ import sys
 import uuid
 from pathlib import Path
 
+from roc.ament_index import resources
 from roc.cli.options import add_discovery_arguments
 from roc.commands.component.containers import add_component_arguments, load
 from roc.commands.node_services import session
 from roc.errors import RocError
 from roc.render import print_lines
-from roc.ros.interfaces import resource_prefixes
 
 CONTAINER_PACKAGE = "rclcpp_components"
 START_TIMEOUT = 15.0  # seconds for the new container to serve load_node
@@ -33,7 +33,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def container_executable() -> Path:
     """rclcpp_components' component_container, from the ament index."""
-    prefix = resource_prefixes("packages").get(CONTAINER_PACKAGE)
+    prefix = resources("packages").get(CONTAINER_PACKAGE)
     if prefix is None:
         raise RocError(f"Package '{CONTAINER_PACKAGE}' not found")
     directory = prefix / "lib" / CONTAINER_PACKAGE

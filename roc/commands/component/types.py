@@ -5,11 +5,11 @@ from __future__ import annotations
 
 import argparse
 
+from roc.ament_index import resources
 from roc.cli.options import add_format_argument
 from roc.commands.component.containers import component_types, packages_with_components
 from roc.errors import RocError
 from roc.render import render
-from roc.ros.interfaces import resource_prefixes
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -19,7 +19,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     if args.package_name is not None:
-        if args.package_name not in resource_prefixes("packages"):
+        if args.package_name not in resources("packages"):
             raise RocError(f"Unable to find package '{args.package_name}'")
         types = component_types(args.package_name)
         render(types, args.format, ["\n".join(types)])  # ros2 prints an empty line for none

@@ -6,13 +6,10 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from functools import partial
 from pathlib import Path
 
 from roc.cli.options import add_discovery_arguments
 from roc.errors import EXIT_FAILURE, EXIT_INTERRUPTED, UsageError
-
-KIND = "probe"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -35,12 +32,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from roc.check.expectations import find_check_file, load_checks
-    from roc.check.probes import probe
-    from roc.engine.events import ProbeResult
+    from roc.check.probes import KIND, probe_console, probe_task
     from roc.engine.executor import execute
-    from roc.engine.process import TaskError
-    from roc.engine.ready import Task
-    from roc.handlers.console import ConsoleHandler
     from roc.handlers.logs import JsonEventsHandler
     from roc.ros.client import Session
 
@@ -54,27 +47,13 @@ def run(args: argparse.Namespace) -> int:
     if not checks.expectations:
         raise UsageError(f"{checks.path}: the [check] table expects nothing; add nodes or [[check.topic]] tables")
 
-    def run_probe(expectation, session, context) -> None:
-        verdict = probe(expectation, session, checks.timeout, checks.rate_window)
-        context.emit(ProbeResult(expectation.label, KIND, status=verdict.status, message=verdict.message,
-                                 expected=expectation.values, measured=verdict.measured))
-        if verdict.status != "pass":
-            raise TaskError(f"{verdict.status}: {verdict.message} ({expectation.where})")
-
-    found: dict[str, str] = {}
-
-    def remember(event) -> None:
-        if isinstance(event, ProbeResult):
-            found[event.key] = event.message
-
     def handlers() -> list:
         """Each round's handlers (a console prints one summary per round)."""
-        chosen: list = [remember, *lasting]
+        chosen: list = [*lasting]
         if args.output == "json":
             chosen.append(JsonEventsHandler(sys.stdout))
         else:
-            chosen.append(ConsoleHandler(sys.stdout, kind=KIND, noun="probe", cached_label="",
-                                         finished_note=lambda key: f"  {found.get(key, '')}"))
+            chosen += probe_console(sys.stdout)
         if args.junit_xml:
             from roc.handlers.junit import JUnitReport
 
@@ -97,8 +76,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         while True:
             started = time.monotonic()
-            tasks = [Task(name=e.label, dependencies=set(), action=partial(run_probe, e, session), kind=KIND)
-                     for e in checks.expectations]
+            tasks = [probe_task(e, session, checks.timeout, checks.rate_window) for e in checks.expectations]
             result = execute(tasks, handlers(), args.parallel_workers, continue_on_error=True, kind=KIND)
             if metrics is not None:
                 metrics.rounds.inc()

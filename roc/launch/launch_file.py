@@ -1,0 +1,149 @@
+"""``roc launch PKG FILE`` / ``roc launch PATH``: a launch file run by the real launch library in a runner
+process (roc/launch/runner.py), watched from here.
+
+The runner prints what ros2 launch prints; here roc keeps the process table (from the runner's events),
+the per-process logs, the live view or the plain lines, the ``--check`` report, and the guarantee that no
+process outlives the run (roc/launch/guard.py).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from roc.launch.running import Running, RunOptions
+
+SETTLE_SECONDS = 1.0  # --check starts once no process has started for this long
+
+
+@dataclass
+class LaunchFile:
+    path: Path
+    arguments: list[tuple[str, str]] = field(default_factory=list)
+    debug: bool = False
+    show_all_output: bool = False
+    launch_prefix: str | None = None
+    launch_prefix_filter: str | None = None
+
+
+def _runner_command(spec: dict) -> list[str]:
+    return [sys.executable, "-m", "roc.launch.runner", json.dumps(spec)]
+
+
+def inspect(launch_file: LaunchFile, mode: str) -> int:
+    """``--print`` or ``--show-args``: the runner prints, nothing is started."""
+    spec = {"mode": mode, "path": str(launch_file.path), "arguments": [], "debug": launch_file.debug}
+    return subprocess.run(_runner_command(spec), stdin=subprocess.DEVNULL).returncode
+
+
+def _arguments(launch_file: LaunchFile) -> list[tuple[str, str]]:
+    """The file's arguments, with --launch-prefix and --launch-prefix-filter as ros2 launch passes them."""
+    arguments = dict(launch_file.arguments)
+    if launch_file.launch_prefix:
+        arguments["launch-prefix"] = launch_file.launch_prefix
+    if launch_file.launch_prefix_filter:
+        arguments["launch-prefix-filter"] = launch_file.launch_prefix_filter
+    return list(arguments.items())
+
+
+def launch(launch_file: LaunchFile, options: RunOptions) -> int:
+    running = Running(options, echo=False)
+    library_logs = running.log_directory / "launch" if running.log_directory else None
+    if library_logs is not None:
+        library_logs.mkdir()
+    events_read, events_write = os.pipe()
+    spec = {"mode": "launch", "path": str(launch_file.path), "arguments": _arguments(launch_file),
+            "debug": launch_file.debug, "events_fd": events_write,
+            "log_dir": str(library_logs) if library_logs else None}
+    extra = {"OVERRIDE_LAUNCH_PROCESS_OUTPUT": "both"} if launch_file.show_all_output else {}
+    runners: list[subprocess.Popen] = []
+
+    def stop() -> None:
+        for runner in runners:  # the library stops its processes (SIGINT, then SIGTERM, then SIGKILL)
+            try:
+                runner.send_signal(signal.SIGINT)
+            except ProcessLookupError:
+                pass
+
+    running.catch_signals(stop)  # first: no process may inherit an ignored SIGINT (a background job's)
+    try:
+        # a process group of its own in roc's session: the terminal's signals reach roc alone, and the
+        # system shares the terminal session's CPU share (its autogroup), as under ros2 launch
+        runner = subprocess.Popen(_runner_command(spec), stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                  stderr=subprocess.STDOUT, pass_fds=(events_write,), process_group=0,
+                                  env=running.environment(extra))
+    except BaseException:
+        running.close()
+        raise
+    finally:
+        os.close(events_write)
+    runners.append(runner)
+    running.guard.record(runner.pid)
+    running.guard.group(runner.pid)
+    if running.stopping.is_set():
+        stop()
+    started = threading.Event()  # the first process started
+    settled = threading.Event()  # and no other started for SETTLE_SECONDS
+    threads = [threading.Thread(target=_read_events, args=(events_read, running, started), daemon=True)]
+    if runner.stdout is not None:
+        threads.append(threading.Thread(target=_relay, args=(runner.stdout, running), daemon=True))
+    for thread in threads:
+        thread.start()
+
+    running.start_check(settled, stop)
+    threading.Thread(target=_settle, args=(running, started, settled, runner), daemon=True).start()
+    try:
+        code = runner.wait()
+    finally:
+        settled.set()
+        running.stopping.set()
+        for thread in threads:
+            thread.join(timeout=5.0)
+        running.close()
+    return running.exit_code(code)
+
+
+def _read_events(fd: int, running: Running, started: threading.Event) -> None:
+    """The runner's JSON lines: each process's start, output and exit."""
+    monitor = running.monitor
+    with os.fdopen(fd, "r", errors="replace") as stream:
+        for line in stream:
+            try:
+                event = json.loads(line)
+            except ValueError:
+                continue
+            if event["event"] == "start":
+                running.guard.record(event["pid"])
+                monitor.started(event["name"], event["pid"], event["cmd"])
+                started.set()
+            elif event["event"] == "output":
+                monitor.output_text(event["name"], event["text"])
+            elif event["event"] == "exit":
+                monitor.exited(event["name"], event["pid"], event["code"])
+
+
+def _settle(running: Running, started: threading.Event, settled: threading.Event, runner: subprocess.Popen) -> None:
+    """Sets ``settled`` once processes started and none started for SETTLE_SECONDS (or the run ended)."""
+    started.wait()
+    while runner.poll() is None:
+        quiet = time.monotonic() - running.monitor.last_start
+        if quiet >= SETTLE_SECONDS:
+            break
+        settled.wait(SETTLE_SECONDS - quiet)
+    settled.set()
+
+
+def _relay(stream, running: Running) -> None:
+    """The runner's own output (ros2 launch's lines), printed as it comes (above the live view)."""
+    while True:
+        data = os.read(stream.fileno(), 65536)
+        if not data:
+            break
+        running.output.write(data.decode(errors="replace"))

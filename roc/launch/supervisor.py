@@ -1,0 +1,122 @@
+"""roc's own process supervisor, for the systems of roc.toml: starts a process (in a process group of its
+own in roc's session: only roc signals it, and it shares the terminal session's CPU share as under ros2
+launch), reads its output into the monitor, restarts it when it has ``respawn``, and
+stops every process as ros2 launch does: SIGINT, then SIGTERM after 5 s, then SIGKILL after 5 s more."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import threading
+from collections.abc import Callable
+
+from roc.engine.process import TaskError
+from roc.launch.monitor import Monitor
+from roc.launch.system import ProcessSpec
+
+SIGTERM_AFTER = 5.0
+SIGKILL_AFTER = 5.0
+
+
+def command(spec: ProcessSpec) -> list[str]:
+    """The process's command line: its package's executable, its arguments, then its ROS arguments."""
+    from roc.ament_index import find_executable
+
+    return [str(find_executable(spec.package, spec.executable)), *spec.arguments, *spec.ros_arguments()]
+
+
+class Supervisor:
+    def __init__(self, monitor: Monitor, environment: Callable[[dict[str, str]], dict[str, str]],
+                 record: Callable[[int], None]):
+        self.monitor = monitor
+        self.environment = environment  # a process's extra variables -> its whole environment
+        self.record = record  # tells the orphan guard about each process started
+        self.stopping = monitor.stopping  # set: no more restarts, and exits are no failures
+        self.failed: list[str] = []  # processes that ended with an error (and are not restarted)
+        self._lock = threading.Lock()
+        self._running: dict[str, subprocess.Popen] = {}
+        self._watchers: list[threading.Thread] = []
+        self._changed = threading.Condition(self._lock)
+
+    def start(self, spec: ProcessSpec) -> None:
+        """Start the process (raises TaskError when it cannot); a thread watches it from then on."""
+        line = command(spec)
+        process = self._spawn(spec, line)
+        watcher = threading.Thread(target=self._watch, args=(spec, line, process), name=f"roc-{spec.label}",
+                                   daemon=True)
+        with self._lock:
+            self._watchers.append(watcher)
+        watcher.start()
+
+    def _spawn(self, spec: ProcessSpec, command: list[str]) -> subprocess.Popen:
+        try:
+            process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                       stderr=subprocess.STDOUT, process_group=0,
+                                       env=self.environment(spec.env))
+        except OSError as error:
+            raise TaskError(f"cannot run '{command[0]}': {error.strerror}") from None
+        self.record(process.pid)
+        with self._lock:
+            self._running[spec.label] = process
+            self._changed.notify_all()
+        self.monitor.started(spec.label, process.pid, command)
+        return process
+
+    def _watch(self, spec: ProcessSpec, command: list[str], process: subprocess.Popen) -> None:
+        while True:
+            assert process.stdout is not None
+            while data := os.read(process.stdout.fileno(), 65536):
+                self.monitor.output_text(spec.label, data.decode(errors="replace"))
+            process.stdout.close()
+            code = process.wait()
+            self.monitor.exited(spec.label, process.pid, code, command)
+            if not spec.respawn or self.stopping.is_set() or self.stopping.wait(spec.respawn_delay):
+                break
+            try:
+                process = self._spawn(spec, command)
+            except TaskError as error:
+                self.monitor.note(f"[ERROR] [{spec.label}]: {error}")
+                break
+        with self._lock:
+            self._running.pop(spec.label, None)
+            if code != 0 and not self.stopping.is_set():
+                self.failed.append(spec.label)
+            self._changed.notify_all()
+
+    def wait(self, stop: threading.Event) -> None:
+        """Until every process has ended for good, or ``stop`` is set."""
+        with self._lock:
+            while self._running and not stop.is_set():
+                self._changed.wait(timeout=0.5)
+
+    def stop(self) -> None:
+        """Stop every process (in parallel), and wait for their watchers."""
+        self.stopping.set()
+        with self._lock:
+            running = list(self._running.items())
+        stoppers = [threading.Thread(target=self._stop_one, args=item, daemon=True) for item in running]
+        for thread in stoppers:
+            thread.start()
+        for thread in stoppers:
+            thread.join()
+        with self._lock:
+            watchers = list(self._watchers)
+        for watcher in watchers:
+            watcher.join(timeout=SIGTERM_AFTER + SIGKILL_AFTER)
+
+    def _stop_one(self, label: str, process: subprocess.Popen) -> None:
+        for signum, grace in ((signal.SIGINT, SIGTERM_AFTER), (signal.SIGTERM, SIGKILL_AFTER),
+                              (signal.SIGKILL, SIGKILL_AFTER)):
+            if process.poll() is not None:
+                return
+            self.monitor.note(f"[INFO] [{label}]: sending signal '{signal.Signals(signum).name}' to process[{label}]")
+            try:
+                os.killpg(process.pid, signum)  # the process leads its own group: its children too
+            except ProcessLookupError:
+                return
+            try:
+                process.wait(timeout=grace)
+                return
+            except subprocess.TimeoutExpired:
+                continue
