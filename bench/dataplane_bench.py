@@ -126,8 +126,10 @@ def main() -> int:
             row = rate_run(env, rate, options.seconds, work)
             truth = row["tail rate"]  # over the hz tools' window: their last report's
 
-            def error(name: str) -> str:
-                return "no output" if row[name] is None else f"{row[name]:.1f} Hz ({(row[name] / truth - 1) * 100:+.2f}%)"
+            def error(name: str, row: dict = row, truth: float = truth) -> str:
+                if row[name] is None:
+                    return "no output"
+                return f"{row[name]:.1f} Hz ({(row[name] / truth - 1) * 100:+.2f}%)"
             print(f"\n{rate:g} Hz for {options.seconds:g} s: published {row['published']} at {row['true rate']:.1f} Hz, "
                   f"the last {min(row['published'], HZ_WINDOW)} at {truth:.1f} Hz")
             print(f"  hz: roc {error('roc hz')}, ros2 {error('ros2 hz')}")

@@ -75,7 +75,7 @@ def run_once(command: list[str], cwd: Path, env: dict[str, str]) -> tuple[float,
     """Wall time, CPU time (user + sys of the process and its children) and the result of one run."""
     cpu = _children_cpu()
     start = time.perf_counter()
-    result = subprocess.run(command, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    result = subprocess.run(command, cwd=cwd, env=env, capture_output=True, text=True)
     elapsed = time.perf_counter() - start
     cpu = _children_cpu() - cpu
     if result.returncode != 0:

@@ -10,6 +10,8 @@
 import signal
 from collections import Counter
 
+import pytest
+
 if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
 

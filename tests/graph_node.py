@@ -78,13 +78,17 @@ def make_node(spec: dict) -> Node:
             message = load(pub["type"])(**pub["values"])
             publisher.publish(message)
             if pub.get("rate_hz"):
-                def tick(p=publisher, m=message, n=node, stamp=pub.get("stamp_now", False)) -> None:
+                stamp_now = pub.get("stamp_now", False)
+
+                def tick(p=publisher, m=message, n=node, stamp=stamp_now) -> None:
                     if stamp:  # a std_msgs/Header: stamped with the time of publication
                         m.stamp = n.get_clock().now().to_msg()
                     p.publish(m)
                 node.create_timer(1.0 / pub["rate_hz"], tick)
     for sub in spec.get("subscribers", []):
-        def received(msg, topic=sub["topic"], show=sub.get("print", False)) -> None:
+        show_messages = sub.get("print", False)
+
+        def received(msg, topic=sub["topic"], show=show_messages) -> None:
             if show:  # one line per message: the topic and the message's repr
                 print(json.dumps({"topic": topic, "message": repr(msg)}), flush=True)
         node.create_subscription(load(sub["type"]), sub["topic"], received, qos(sub))

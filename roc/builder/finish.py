@@ -60,7 +60,8 @@ def finish_package(package: Package, prefix: Path) -> None:
                 f.is_file() and f.name.startswith("Find") and f.name.endswith(".cmake") for f in directory.iterdir()):
             suffix = str(len(module_dirs)) if module_dirs else ""
             module_dirs.append(directory)
-            hook(f"cmake_module_path{suffix}", f"prepend-non-duplicate;CMAKE_MODULE_PATH;{directory.relative_to(prefix)}")
+            relative = directory.relative_to(prefix)
+            hook(f"cmake_module_path{suffix}", f"prepend-non-duplicate;CMAKE_MODULE_PATH;{relative}")
     if _has_cmake_config(prefix):
         hook("cmake_prefix_path", "prepend-non-duplicate;CMAKE_PREFIX_PATH;")
     for lib in sorted(prefix.glob("lib*")):

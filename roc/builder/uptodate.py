@@ -84,7 +84,8 @@ class Fingerprints:
             "sources": source_parts(files),
             "options": _options_parts(package, self.options),
             "toolchain": toolchain_parts(self.environment, self.options.install_base, tools),
-            "dependencies": {n: self._fingerprint(n) for n in sorted(self.workspace.dependencies.recursive(package.name))},
+            "dependencies": {n: self._fingerprint(n)
+                             for n in sorted(self.workspace.dependencies.recursive(package.name))},
             "underlay": {n: self._underlay(n) for n in sorted(package.direct_dependencies() - by_name.keys())},
         }
         generated = generated_stamps(source, self.options.build_base / package.name)

@@ -1,8 +1,9 @@
 """cmake and ament_cmake packages: configure when needed, build, install.
 
 Configure runs only when there is no CMake cache, the arguments changed (``cmake_args.last``, as
-colcon keeps it) or it is forced; when the compilers or the build program changed, with a new cache. Switching ``--symlink-install`` on or off cleans what the other mode
-left (see ``switch_install_mode``). Makefile builds take part in roc's global jobserver.
+colcon keeps it) or it is forced; when the compilers or the build program changed, with a new cache.
+Switching ``--symlink-install`` on or off cleans what the other mode left (see
+``switch_install_mode``). Makefile builds take part in roc's global jobserver.
 """
 
 from __future__ import annotations

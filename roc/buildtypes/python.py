@@ -46,7 +46,8 @@ def build_python(context: TaskContext, job: PackageJob, options: BuildOptions) -
         unlink_symlinks(record)
     command = [
         # setuptools' deprecation notices of these commands, silenced as colcon silences them
-        sys.executable, "-W", "ignore:setup.py install is deprecated", "-W", "ignore:easy_install command is deprecated",
+        sys.executable, "-W", "ignore:setup.py install is deprecated",
+        "-W", "ignore:easy_install command is deprecated",
         "setup.py",
         "egg_info", "--egg-base", str(job.build_dir),
         "build", "--build-base", str(job.build_dir / "build"),

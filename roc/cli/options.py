@@ -42,7 +42,8 @@ def add_selection_arguments(parser: argparse.ArgumentParser) -> None:
         help="only packages that (recursively) depend on any of these")
     add("--packages-skip-by-dep", nargs="*", metavar="DEP_NAME",
         help="skip packages that (recursively) depend on any of these")
-    add("--packages-skip-up-to", nargs="*", metavar="PKG_NAME", help="skip these packages and their recursive dependencies")
+    add("--packages-skip-up-to", nargs="*", metavar="PKG_NAME",
+        help="skip these packages and their recursive dependencies")
     previous = group.add_mutually_exclusive_group()
     previous.add_argument("--packages-select-build-failed", action="store_true",
                           help="only packages whose last build failed (aborted ones are not failures)")
@@ -75,7 +76,8 @@ class AppendToCommandLine(argparse._AppendAction):
 
 def add_base_arguments(parser: argparse.ArgumentParser) -> None:
     """Where the build directories and install prefixes are (build, cache, env)."""
-    parser.add_argument("--build-base", default="build", help="base directory of the build directories (default: build)")
+    parser.add_argument("--build-base", default="build",
+                        help="base directory of the build directories (default: build)")
     parser.add_argument("--install-base", default="install",
                         help="base directory of the install prefixes (default: install)")
     parser.add_argument("--merge-install", action="store_true", help="install all packages into one prefix")

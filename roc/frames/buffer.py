@@ -114,7 +114,8 @@ class Buffer:
         known = self.frames()
         for name, role in ((target, "target"), (source, "source")):
             if name not in known:
-                raise TransformUnavailable(f"frame '{name}' ({role}) does not exist (frames: {', '.join(known) or 'none yet'})")
+                listed = ", ".join(known) or "none yet"
+                raise TransformUnavailable(f"frame '{name}' ({role}) does not exist (frames: {listed})")
         up_from_source, up_from_target = self.chain(source), self.chain(target)
         common = next((frame for frame in up_from_source if frame in up_from_target), None)
         if common is None:

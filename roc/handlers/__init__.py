@@ -36,7 +36,9 @@ def add_event_handlers_argument(parser: argparse.ArgumentParser) -> None:
     action = parser.add_argument(
         "--event-handlers", nargs="*", metavar="NAME+/-", default=[],
         help="enable (+) or disable (-) output: " + ", ".join(EVENT_HANDLERS))
-    action.completion = [f"{name}{sign}" for name in sorted(EVENT_HANDLERS) for sign in "+-"]
+    # the words roc/commands/completion.py offers for it (not argparse choices: several may be given)
+    words = [f"{name}{sign}" for name in sorted(EVENT_HANDLERS) for sign in "+-"]
+    action.completion = words  # type: ignore[attr-defined]
 
 
 def handler_switches(values: list[str]) -> dict[str, bool]:

@@ -187,7 +187,7 @@ class Converter:
                 consts.append(line.strip()[len(naming.CONSTANT_MARK):])
             else:
                 out.append(f"# {line.rstrip()}".rstrip())
-        for j, enum in enumerate(message.enum_type):
+        for enum in message.enum_type:
             consts += self.constants(self.definitions[f"{definition.full}.{enum.name}"])
         oneofs = {}
         for o, oneof in enumerate(message.oneof_decl):

@@ -68,7 +68,8 @@ def to_ros(message, ros_type) -> Any:
         slot = slots[name]
         if _is_map(field):
             entry, value_field = _ros_class(slot), field.message_type.fields_by_name["value"]
-            value = [entry(key=k, value=_to_ros_single(value_field, v, _entry_value_slot(entry))) for k, v in value.items()]
+            slot_of_values = _entry_value_slot(entry)
+            value = [entry(key=k, value=_to_ros_single(value_field, v, slot_of_values)) for k, v in value.items()]
         elif _is_repeated(field):
             value = [_to_ros_single(field, v, _element(slot), repeated=True) for v in value]
         else:

@@ -37,10 +37,10 @@ class LazySession:
             return self._session
 
     def query(self, *args, **kwargs):
-        return self._get().query(*args, **kwargs)  # type: ignore[attr-defined]
+        return self._get().query(*args, **kwargs)
 
     def stream(self, *args, **kwargs):
-        return self._get().stream(*args, **kwargs)  # type: ignore[attr-defined]
+        return self._get().stream(*args, **kwargs)
 
     def close(self) -> None:
         if self._session is not None:

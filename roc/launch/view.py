@@ -77,7 +77,7 @@ class Usage:
             process = self._processes.get(pid)
             if process is None:
                 process = self._processes[pid] = psutil.Process(pid)
-                process.cpu_percent()  # type: ignore[attr-defined]  # the first call starts the measurement
+                process.cpu_percent()  # the first call starts the measurement
             with process.oneshot():  # type: ignore[attr-defined]
                 return (f"{process.cpu_percent():.0f}%",  # type: ignore[attr-defined]
                         _memory(process.memory_info().rss))  # type: ignore[attr-defined]

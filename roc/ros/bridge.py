@@ -165,8 +165,8 @@ class DomainBridge:
         if self.everything is not None:
             source, target = self.everything
             named = {r.name for r in routes if r.from_domain == source and r.kind == "topic"}
-            routes += [Route(name, source, target) for name, _types in self.graphs[source].node.get_topic_names_and_types()
-                       if name not in named and self.wanted(name)]
+            found = self.graphs[source].node.get_topic_names_and_types()
+            routes += [Route(name, source, target) for name, _types in found if name not in named and self.wanted(name)]
         return routes
 
     def _source_type(self, route: Route) -> str | None:
@@ -239,7 +239,8 @@ class DomainBridge:
                 rates = {}
                 for key, link in self.links.items():
                     kind, source, name, target = key
-                    rates[f"{'service ' if kind == 'service' else ''}{name} ({source}->{target})"] = (link.count - counts.get(key, 0)) / (now - last)
+                    label = f"{'service ' if kind == 'service' else ''}{name} ({source}->{target})"
+                    rates[label] = (link.count - counts.get(key, 0)) / (now - last)
                     counts[key] = link.count
                 last = now
                 yield {"event": "rates", "rates": rates}

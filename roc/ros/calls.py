@@ -9,6 +9,7 @@ import queue
 import threading
 import time
 from collections.abc import Callable, Iterator
+from functools import partial
 from typing import Any
 
 from rclpy.serialization import deserialize_message
@@ -39,7 +40,7 @@ def call(graph, params: dict[str, Any]) -> Events:
         while True:
             yield {"event": "request"}
             future = client.call_async(request)
-            yield from _wait(lambda: _done(future))
+            yield from _wait(partial(_done, future))
             yield {"event": "response", "data": base64.b64encode(serialize(future.result())).decode()}
             if period is None:
                 return

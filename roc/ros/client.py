@@ -1,7 +1,8 @@
 """Graph queries from a verb: through the roc daemon (started on demand), or locally with ``--no-daemon``.
 
 This module never imports rclpy: a query through a warm daemon costs a socket round trip, not
-rclpy's import time. Modules only needed to start a daemon are imported when one is started. The protocol is in docs/daemon.md.
+rclpy's import time. Modules only needed to start a daemon are imported when one is started. The
+protocol is in docs/daemon.md.
 """
 
 from __future__ import annotations

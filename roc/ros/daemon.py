@@ -45,7 +45,7 @@ class Daemon:
         self.stopping = threading.Event()
         self.created = threading.Event()  # the graph participant exists
         self.ready = threading.Event()  # ... and has had its discovery period
-        self.graph = None
+        self.graph: Any = None  # the roc.ros.graph.Graph, once created (imported then: rclpy is slow to load)
         self.started = time.time()
 
     def serve(self) -> None:

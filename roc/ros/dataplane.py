@@ -1,8 +1,9 @@
 """Moving data on a live graph: subscriptions (``echo``, ``stats``, ``frames``) and a publisher
 (``publish``) on a Graph's node, each a stream of plain-data events (roc.ros.streams names them
 all). The same generators run inside the roc daemon (each event a line on the client's socket, so
-the endpoint lives in an already discovered participant) and in a daemon-less run. Messages travel as serialised CDR (base64 in JSON); the client turns them into
-message objects (``roc.ros.cdr.decode``), so the daemon never needs a verb's output options.
+the endpoint lives in an already discovered participant) and in a daemon-less run. Messages travel as
+serialised CDR (base64 in JSON); the client turns them into message objects
+(``roc.ros.cdr.decode``), so the daemon never needs a verb's output options.
 
 A stream ends when its generator is closed: the daemon closes it when the client goes away (a
 heartbeat event at least every HEARTBEAT_SECONDS finds out), and the ``finally`` blocks destroy the
@@ -14,7 +15,7 @@ from __future__ import annotations
 import base64
 import struct
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Hashable
 from typing import Any
 
 from rclpy.qos import (
@@ -153,8 +154,8 @@ def publish(graph, params: dict[str, Any], prepare: Callable[[], bytes] | None =
     """Publish ``params["data"]`` (base64 CDR of a ``type`` message) on ``topic``: wait for ``wait``
     matching subscriptions (``{"event": "waiting"}`` each second, at most ``max_wait`` seconds), then
     ``times`` messages (0: until closed) at ``rate`` Hz, ``{"event": "published", "count"}`` after each,
-    keeping the publisher ``keep_alive`` seconds after the last (null: until closed). In-process only: ``prepare`` gives the
-    CDR to send before each message (stamped with the time)."""
+    keeping the publisher ``keep_alive`` seconds after the last (null: until closed). In-process only:
+    ``prepare`` gives the CDR to send before each message (stamped with the time)."""
     cls = message_class(params["type"])
     data = base64.b64decode(params["data"])
     profile = qos_profile({"profile": "default", **params.get("qos", {})})
@@ -224,7 +225,8 @@ def stats(graph, params: dict[str, Any]) -> Events:
             receiver.subscribe(topic, cls, topic, subscription_profile(qos, found))
             yield {"event": "subscribed", "topic": topic, "type": type_name}
         while True:
-            arrived = {topic: {column: [] for column in columns} for topic in params["topics"]}
+            arrived: dict[Hashable, dict[str, list]] = {topic: {column: [] for column in columns}
+                                                        for topic in params["topics"]}
             due = time.monotonic() + period
             while (remaining := due - time.monotonic()) > 0:
                 for topic, data, info in receiver.batch(remaining):
@@ -248,7 +250,8 @@ def frames(graph, params: dict[str, Any]) -> Events:
     serves it before its discovery period."""
     cls = message_class(TF_TYPE)
     dynamic = qos_profile({"profile": "default", "depth": 100}, graph.node.get_publishers_info_by_topic("/tf"))
-    static = qos_profile({"profile": "default", "depth": 100, "durability": "transient_local", "reliability": "reliable"})
+    static = qos_profile({"profile": "default", "depth": 100, "durability": "transient_local",
+                          "reliability": "reliable"})
     receiver = Receiver(graph.node)
     nodes = PublisherNames(graph)
     try:
@@ -257,7 +260,7 @@ def frames(graph, params: dict[str, Any]) -> Events:
         yield {"event": "subscribed", "type": TF_TYPE}
         while True:
             messages = [{"static": topic == "/tf_static", "data": base64.b64encode(data).decode(),
-                         "received": info["received_timestamp"], "publisher": nodes.name(topic, info["gid"])}
+                         "received": info["received_timestamp"], "publisher": nodes.name(str(topic), info["gid"])}
                         for topic, data, info in receiver.batch(HEARTBEAT_SECONDS, MAX_BATCH)]
             yield {"event": "messages", "messages": messages} if messages else {"event": "heartbeat"}
     finally:

@@ -18,8 +18,8 @@ free port of 127.0.0.1, and a small ``websockets`` server on the public address 
 name and relays every frame both ways unchanged (one upstream connection per client; ``_Session``
 has the one repair). This keeps the whole protocol (channel ids, subscriptions, client channels) in
 the maintained SDK rather than in a home-made server, adds only a localhost hop
-(bench/foxglove_bench.py: 0.3 ms added at the median at 1 kHz, with the ROS side), and tells us about client connections,
-which the SDK's listener does not.
+(bench/foxglove_bench.py: 0.3 ms added at the median at 1 kHz, with the ROS side), and tells us
+about client connections, which the SDK's listener does not.
 
 The server never prints: ``run`` yields status events.
 """
@@ -135,7 +135,8 @@ class _Relay:
             raise RocError(f"cannot listen on {host}:{port}: {error.strerror or error}") from None
 
     async def _start(self, host: str, port: int):
-        return await serve(self._relay, host, port, subprotocols=[Subprotocol(name) for name in SUBPROTOCOLS], compression=None,
+        return await serve(self._relay, host, port, subprotocols=[Subprotocol(name) for name in SUBPROTOCOLS],
+                           compression=None,
                            max_size=None, close_timeout=CLOSE_SECONDS)
 
     async def _relay(self, client) -> None:
@@ -322,7 +323,8 @@ class FoxgloveServer:
             if joins and topic.subscription is not None and topic.subscription.qos_profile.durability == LATCHED:
                 self._unsubscribe_ros(topic)  # a new subscription gets the kept messages for the new client too
             if topic.subscription is None:
-                qos = receive_profile(qos_profile({"profile": "default"}, self.graph.node.get_publishers_info_by_topic(name)))
+                publishers = self.graph.node.get_publishers_info_by_topic(name)
+                qos = receive_profile(qos_profile({"profile": "default"}, publishers))
                 log = topic.channel.log
 
                 def forward(data: bytes, topic: _Topic = topic) -> None:

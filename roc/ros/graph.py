@@ -368,7 +368,8 @@ class Graph:
     def param_values(self, node_name: str, names: list[str]) -> list[dict[str, Any]]:
         from rcl_interfaces.srv import GetParameters
 
-        response = self.call_node_service(node_name, "get_parameters", GetParameters, GetParameters.Request(names=names))
+        request = GetParameters.Request(names=names)
+        response = self.call_node_service(node_name, "get_parameters", GetParameters, request)
         return [parameter_value(v) for v in response.values]
 
     def param_types(self, node_name: str, names: list[str]) -> list[int]:

@@ -125,8 +125,8 @@ def show_lines(type_name: str, comments: bool = True, nested_comments: bool = Fa
         start = _comment_start(text)
         comment = _comment_text(text[start + 1:]) if start >= 0 else ""
         # As ros2 (rosidl's parser): a comment line starts in column 0 and has text ('#', '##' or a
-        # lone unit such as '# [m]' is no comment, nor is an indented one); a trailing comment is cut one character before its
-        # text, which keeps the '#' of '# text'.
+        # lone unit such as '# [m]' is no comment, nor is an indented one); a trailing comment is cut one
+        # character before its text, which keeps the '#' of '# text'.
         is_comment = text.startswith("#") and bool(_comment_text(text.lstrip("#")))
         shown = text
         if not comments:

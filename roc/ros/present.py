@@ -62,7 +62,8 @@ def qos_problems(publisher: dict[str, Any], subscriber: dict[str, Any]) -> list[
                          "TRANSIENT_LOCAL", "fix": "make the subscriber VOLATILE or the publisher TRANSIENT_LOCAL"})
     if _longer(offered["deadline_ns"], requested["deadline_ns"]):
         problems.append({"policy": "deadline", "message": f"publisher offers a deadline of "
-                         f"{_duration(offered['deadline_ns'])}, subscriber requests {_duration(requested['deadline_ns'])}",
+                         f"{_duration(offered['deadline_ns'])}, subscriber requests "
+                         f"{_duration(requested['deadline_ns'])}",
                          "fix": "give the publisher a deadline no longer than the subscriber's, or lengthen the "
                                 "subscriber's"})
     if _LIVELINESS_ORDER.get(offered["liveliness"], 0) < _LIVELINESS_ORDER.get(requested["liveliness"], 0):

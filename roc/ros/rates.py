@@ -19,7 +19,7 @@ NS = 1e-9
 class Sample:
     sequence: int | None
     source: int | None  # ns
-    received: int | None  # ns
+    received: int  # ns
     size: int
     stamp: int | None  # ns, the message's header stamp
 
@@ -40,7 +40,8 @@ class Window:
     def add(self, new: list[Sample]) -> None:
         for sample in new:
             last = self.samples[-1] if self.samples else None
-            if last and last.sequence is not None and sample.sequence is not None and sample.sequence > last.sequence + 1:
+            if (last and last.sequence is not None and sample.sequence is not None
+                    and sample.sequence > last.sequence + 1):
                 self.lost += sample.sequence - last.sequence - 1
             self.samples.append(sample)
 
@@ -63,10 +64,10 @@ class Window:
         times = self._times(wall_time)
         if len(times) < 2 or times[-1] == times[0]:
             return None
-        first, last = self.samples[0], self.samples[-1]
+        first, last = self.samples[0].sequence, self.samples[-1].sequence
         one_publisher = all(a.sequence is not None and b.sequence is not None and a.sequence < b.sequence
                             and (a.source or 0) <= (b.source or 0) for a, b in itertools.pairwise(self.samples))
-        messages = last.sequence - first.sequence if one_publisher else len(times) - 1
+        messages = last - first if one_publisher and first is not None and last is not None else len(times) - 1
         return messages / ((times[-1] - times[0]) * NS)
 
     def _times(self, wall_time: bool) -> list[int]:
@@ -85,7 +86,7 @@ class Window:
 
     def delay(self) -> dict | None:
         """``{delay, min, max, std_dev, window}``: reception time minus header stamp (seconds)."""
-        delays = [(s.received - s.stamp) * NS for s in self.samples if s.stamp is not None and s.received]
+        delays = [(s.received - s.stamp) * NS for s in self.samples if s.stamp is not None]
         if not delays:
             return None
         return {"delay": statistics.fmean(delays), "min": min(delays), "max": max(delays),

@@ -34,9 +34,11 @@ def check_selection_arguments(args: argparse.Namespace, names: set[str]) -> None
     depth_args = getattr(args, "packages_above_depth", None) or []
     if depth_args:
         if not depth_args[0].isdigit():
-            raise UsageError(f"--packages-above-depth: the first value must be a depth (0, 1, ...), not '{depth_args[0]}'")
+            raise UsageError("--packages-above-depth: the first value must be a depth (0, 1, ...), "
+                             f"not '{depth_args[0]}'")
     checks = [(option, getattr(args, option, None) or []) for option in NAME_OPTIONS]
-    checks += [("packages_above_depth", depth_args[1:]), ("packages_start", [args.packages_start] if args.packages_start else []),
+    checks += [("packages_above_depth", depth_args[1:]),
+               ("packages_start", [args.packages_start] if args.packages_start else []),
                ("packages_end", [args.packages_end] if args.packages_end else [])]
     for option, values in checks:
         for name in values:
@@ -99,7 +101,8 @@ def select_packages(args: argparse.Namespace, ordered: list[Package], build_base
     if args.packages_skip_up_to:
         selected -= up_to(set(args.packages_skip_up_to))
     if (args.packages_select_build_failed or args.packages_skip_build_finished
-            or getattr(args, "packages_select_test_failures", False) or getattr(args, "packages_skip_test_passed", False)):
+            or getattr(args, "packages_select_test_failures", False)
+            or getattr(args, "packages_skip_test_passed", False)):
         selected &= _by_previous_result(args, ordered, build_base or Path("build"))
     if args.packages_select is not None or args.packages_select_regex is not None:
         chosen = set(args.packages_select or [])

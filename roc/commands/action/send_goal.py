@@ -48,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
             kind = event["event"]
             if interrupted and goal_id is None:
                 raise KeyboardInterrupt  # nothing to cancel yet
-            if interrupted and not canceling:
+            if interrupted and goal_id is not None and not canceling:
                 canceling = True
                 _cancel(args, goal_id)  # then the server ends the goal, and the stream with its result
             if kind == "accepted":
@@ -64,7 +64,8 @@ def run(args: argparse.Namespace) -> int:
                 if text:
                     print_text(f"Feedback:\n    {_indented(feedback)}\n\n")
                 else:
-                    print_json_line({"action": args.action_name, "goal_id": goal_id, "feedback": value_to_data(feedback)})
+                    print_json_line({"action": args.action_name, "goal_id": goal_id,
+                                     "feedback": value_to_data(feedback)})
             elif kind == "result":
                 result = decode(cls.Result, event["data"])
                 if canceling:

@@ -51,7 +51,8 @@ def run(args: argparse.Namespace) -> int:
                 print_text(json_line({"source": args.source_frame, "target": args.target_frame, "stamp": stamp * 1e-9,
                                       **transform_data(transform)}))
             else:
-                print_text("\n".join([f"At time {stamp * 1e-9:.9f}", *transform_lines(transform, args.precision)]) + "\n")
+                lines = [f"At time {stamp * 1e-9:.9f}", *transform_lines(transform, args.precision)]
+                print_text("\n".join(lines) + "\n")
             if args.once:
                 return 0
             listener.listen(seconds=1.0 / args.rate)  # returns at the first batch or heartbeat after that

@@ -47,9 +47,12 @@ def heard_frames(args: argparse.Namespace) -> list[dict]:
 
 def run(args: argparse.Namespace) -> int:
     rows = heard_frames(args)
-    text = table_lines([[r["frame"], r["parent"] or "-", "-" if r["static"] is None else "static" if r["static"] else "dynamic",
-                         f"{r['rate']:.1f} Hz" if r["rate"] else "-", f"{r['age']:.3f} s" if r["age"] is not None else "-",
-                         ", ".join(r["publishers"]) or "-"] for r in rows],
-                       header=["frame", "parent", "kind", "rate", "age", "publishers"]) if rows else ["no tf frames heard"]
+    def kind(static: bool | None) -> str:
+        return "-" if static is None else "static" if static else "dynamic"
+
+    table = [[r["frame"], r["parent"] or "-", kind(r["static"]), f"{r['rate']:.1f} Hz" if r["rate"] else "-",
+              f"{r['age']:.3f} s" if r["age"] is not None else "-", ", ".join(r["publishers"]) or "-"] for r in rows]
+    text = (table_lines(table, header=["frame", "parent", "kind", "rate", "age", "publishers"]) if rows
+            else ["no tf frames heard"])
     render(rows, args.format, text)
     return 0

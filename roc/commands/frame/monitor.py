@@ -61,9 +61,9 @@ def run(args: argparse.Namespace) -> int:
                 continue
             def seconds(value):
                 return f"{value:.4f} s" if value is not None else "-"
-            lines = table_lines([[r["frame"], r["parent"], f"{r['rate']:.1f} Hz" if r["rate"] else "-",
-                                  seconds(r["delay_average"]), seconds(r["delay_max"]), ", ".join(r["publishers"]) or "-"]
-                                 for r in rows], header=["frame", "parent", "rate", "delay avg", "delay max", "publishers"])
+            table = [[r["frame"], r["parent"], f"{r['rate']:.1f} Hz" if r["rate"] else "-", seconds(r["delay_average"]),
+                      seconds(r["delay_max"]), ", ".join(r["publishers"]) or "-"] for r in rows]
+            lines = table_lines(table, header=["frame", "parent", "rate", "delay avg", "delay max", "publishers"])
             if args.frames and only is None:
                 lines = [f"waiting for {args.frames[0]} and {args.frames[1]} to be connected"]
             print_text("\n".join([*lines, ""]) + "\n")

@@ -25,7 +25,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--degrees", action="store_true", help="--roll, --pitch and --yaw are in degrees")
     for part in ("qx", "qy", "qz", "qw"):
         parser.add_argument(f"--{part}", type=float, help="the rotation as a quaternion (instead of roll/pitch/yaw)")
-    parser.add_argument("--rate", type=float, metavar="HZ", help="publish on /tf this often (default: once, on /tf_static)")
+    parser.add_argument("--rate", type=float, metavar="HZ",
+                        help="publish on /tf this often (default: once, on /tf_static)")
     parser.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this long (default: Ctrl+C)")
     add_discovery_arguments(parser)
 

@@ -28,7 +28,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--full-length", "-f", action="store_true",
                         help="do not truncate arrays, bytes and strings")
     parser.add_argument("--truncate-length", "-l", type=int, default=DEFAULT_TRUNCATE_LENGTH, metavar="N",
-                        help=f"truncate arrays, bytes and strings after N elements (default: {DEFAULT_TRUNCATE_LENGTH})")
+                        help="truncate arrays, bytes and strings after N elements "
+                             f"(default: {DEFAULT_TRUNCATE_LENGTH})")
     parser.add_argument("--no-arr", action="store_true", help="do not print array fields")
     parser.add_argument("--no-str", action="store_true", help="do not print string fields")
     parser.add_argument("--flow-style", action="store_true", help="print lists inline (not with --csv)")

@@ -78,7 +78,8 @@ def _filtered(args: argparse.Namespace, topic: str, accept, wait: float):
     from roc.ros.cdr import decode
 
     columns = ("sequence", "source", "received", "size", "stamp")
-    batch, type_name, due = {column: [] for column in columns}, None, time.monotonic() + 1.0
+    batch: dict[str, list] = {column: [] for column in columns}
+    type_name, due = "", time.monotonic() + 1.0
     for event in stream("echo", {"topic": topic, "wait": wait}, use_daemon=not args.no_daemon):
         if event["event"] == "not_published":
             yield {"event": "not_published", "topic": topic}
@@ -87,7 +88,7 @@ def _filtered(args: argparse.Namespace, topic: str, accept, wait: float):
             yield {"event": "subscribed", "topic": topic, "type": type_name}
         elif event["event"] == "messages":
             for message in event["messages"]:
-                if accept(decode(type_name, message["data"])):
+                if accept(decode(type_name, message["data"])):  # "subscribed" came first
                     info = message["info"]
                     for column, value in zip(columns, (
                             None, info.get("source_timestamp"),

@@ -172,7 +172,8 @@ def _explain(args: argparse.Namespace, workspace, options, remote) -> int:
     if args.output == "json":
         print_json([{"package": name, "kind": kind, "reasons": reasons} for kind, name, reasons in explained])
     else:
-        print_lines([f"{task_key(kind, name)}: {'; '.join(reasons) or 'up to date'}" for kind, name, reasons in explained])
+        print_lines([f"{task_key(kind, name)}: {'; '.join(reasons) or 'up to date'}"
+                     for kind, name, reasons in explained])
     return 0
 
 

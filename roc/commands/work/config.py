@@ -35,7 +35,8 @@ def run(args: argparse.Namespace) -> int:
         setting = applied.get(action.dest)
         source = "default"
         if setting is not None:
-            source = f"{setting.source}" + (f" ({setting.path}:{setting.line})" if setting.line else f" ({setting.path})")
+            where = f"{setting.path}:{setting.line}" if setting.line else f"{setting.path}"
+            source = f"{setting.source} ({where})"
         rows.append({"option": max(action.option_strings, key=len), "value": verb_parser.get_default(action.dest),
                      "source": source})
     packages = {name: {key: {"value": s.value, "source": s.source} for key, s in settings.items()}

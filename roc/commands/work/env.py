@@ -1,4 +1,5 @@
-"""``roc work env PKG [-- CMD...]``: what a package's build environment changes (to eval), all of it, or CMD run in it."""
+"""``roc work env PKG [-- CMD...]``: what a package's build environment changes (to eval), all of it,
+or CMD run in it."""
 
 from __future__ import annotations
 

@@ -74,7 +74,8 @@ def package_details(package: Package) -> dict:
             "urls": [{"type": t, "url": u} for t, u in manifest.urls],
             "build_type": manifest.build_type,
             "dependencies": [
-                {"name": d.name, "tag": d.tag, **dict(d.versions), **({"condition": d.condition} if d.condition else {})}
+                {"name": d.name, "tag": d.tag, **dict(d.versions),
+                 **({"condition": d.condition} if d.condition else {})}
                 for d in manifest.dependencies
             ],
             "group_depends": manifest.group_depends,

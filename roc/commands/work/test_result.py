@@ -42,7 +42,8 @@ def run(args: argparse.Namespace) -> int:
         write_text_atomic(Path(args.junit_xml), merged_junit(results, base).decode())
     if args.format == "json":
         print_json({"results": [result.as_dict() for result in (results if args.all else shown)],
-                    "summary": {key: value for key, value in summary.as_dict().items() if key not in ("path", "details")}})
+                    "summary": {key: value for key, value in summary.as_dict().items()
+                                if key not in ("path", "details")}})
     elif args.result_files_only:
         print_lines(result.path for result in shown)
     else:
