@@ -4,12 +4,13 @@ of a type only a remote node knows: on a live graph, side by side with the ros2 
 from __future__ import annotations
 
 import json
+import shutil
 import subprocess
 import time
 from pathlib import Path
 
 import pytest
-from build_helpers import BIN, stop_process
+from build_helpers import BIN, REPO, stop_process
 from graph_helpers import (
     ORACLE_VENV,
     graph_env,
@@ -31,7 +32,6 @@ SERVER = {"name": "motor", "services": [
     "clients": [{"name": "/motor/enable", "type": "std_srvs/srv/SetBool"}],
     "actions": [{"name": "fibonacci"}], "parameters": {"max_speed": 1.5}}
 HIDDEN = {"name": "_hidden", "parameters": {"secret": 7}}
-POSER = {"name": "poser", "publishers": [{"topic": "pose", "type": "geometry_msgs/msg/PoseStamped"}]}
 
 
 @pytest.fixture(scope="module")
@@ -40,13 +40,11 @@ def graph(tmp_path_factory):
     if reason:
         pytest.skip(f"the ros2 CLI oracle is not available: {reason}")
     env = graph_env(24, tmp_path_factory.mktemp("runtime"))
-    processes = start_nodes([[SERVER, HIDDEN], [POSER]], env)
+    processes = start_nodes([[SERVER, HIDDEN]], env)
     roc("daemon", "start", env=env)
     ros2("daemon", "start", env=env)  # ros2 without its daemon misses services at times
     for tool in (roc, ros2):
-        wait_for(lambda tool=tool: {"/echo_types", "/motor/enable"} <= set(tool("service", "list", env=env).stdout
-                                                                            .split())
-                 and "/poser" in tool("node", "list", env=env).stdout)
+        wait_for(lambda tool=tool: {"/echo_types", "/motor/enable"} <= set(tool("service", "list", env=env).stdout.split()))
     yield env
     stop_daemon(env)  # (and ros2's)
     stop_all(processes)
@@ -221,19 +219,38 @@ def test_param_list_include_hidden_nodes_as_ros2(graph):
         assert oracle.stderr.strip() in got.stderr
 
 
+def _built_demo_interfaces(workspace: Path, env: dict[str, str]) -> dict[str, str]:
+    """demo_interfaces of the example workspace built by roc into ``workspace``: the environment of a shell
+    that sourced it (a robot that has the package; roc's own environment does not)."""
+    shutil.copytree(REPO / "workspaces" / "example" / "src" / "demo_interfaces", workspace / "src" / "demo_interfaces")
+    built = subprocess.run([str(BIN / "roc"), "work", "build"], cwd=workspace, env=env, capture_output=True,
+                           text=True, timeout=600)
+    assert built.returncode == 0, built.stdout + built.stderr
+    sourced = subprocess.run(["bash", "-c", "source install/setup.bash && env -0"], cwd=workspace, env=env,
+                             capture_output=True, text=True, timeout=60)
+    assert sourced.returncode == 0, sourced.stderr
+    return dict(line.split("=", 1) for line in sourced.stdout.split("\0") if "=" in line)
+
+
 def test_interface_show_asks_a_node_for_a_type_not_installed_here(graph, tmp_path: Path):
+    """A node on the graph publishes demo_interfaces/msg/Reading, which only its own environment has: roc,
+    unsourced, shows the type from the node's type description service, as ros2 shows it where the
+    package is installed."""
     env = graph
-    empty = tmp_path / "prefix"  # an ament index that knows no package: nothing installed here
-    (empty / "share" / "ament_index" / "resource_index" / "packages").mkdir(parents=True)
-    bare = {**env, "AMENT_PREFIX_PATH": str(empty)}  # (the same daemon: its key is the discovery environment)
-    for type_name in ("geometry_msgs/msg/PoseStamped", "std_msgs/msg/Header"):  # used, and nested in one
+    robot = _built_demo_interfaces(tmp_path / "robot", env)
+    node = start_nodes([{"name": "reader", "publishers": [{"topic": "readings", "type": "demo_interfaces/msg/Reading"}]}],
+                       robot)
+    try:
+        wait_for(lambda: "/reader" in roc("node", "list", env=env).stdout)
         for flags in ((), ("--no-comments",), ("--all-comments",)):
-            shown = roc("interface", "show", type_name, *flags, env=bare)
+            shown = roc("interface", "show", "demo_interfaces/msg/Reading", *flags, env=env)
             assert shown.returncode == 0, shown.stderr
-            assert shown.stdout == ros2("interface", "show", type_name, *flags, env=env).stdout
-    data = json.loads(roc("interface", "show", "geometry_msgs/msg/PoseStamped", "--format", "json", env=bare).stdout)
-    assert (data["node"], data["file"]) == ("/poser", None)
-    no_daemon = roc("interface", "show", "geometry_msgs/msg/PoseStamped", "--no-daemon", env=bare)
-    assert no_daemon.stdout == ros2("interface", "show", "geometry_msgs/msg/PoseStamped", env=env).stdout
-    unknown = roc("interface", "show", "nav_msgs/msg/Odometry", env=bare)
-    assert unknown.returncode == 1 and "Unknown package 'nav_msgs'" in unknown.stderr
+            assert shown.stdout == ros2("interface", "show", "demo_interfaces/msg/Reading", *flags, env=robot).stdout
+        data = json.loads(roc("interface", "show", "demo_interfaces/msg/Reading", "--format", "json", env=env).stdout)
+        assert (data["node"], data["file"]) == ("/reader", None)
+        no_daemon = roc("interface", "show", "demo_interfaces/msg/Reading", "--no-daemon", env=env)
+        assert no_daemon.stdout == ros2("interface", "show", "demo_interfaces/msg/Reading", env=robot).stdout
+        unknown = roc("interface", "show", "nowhere_msgs/msg/Thing", env=env)
+        assert unknown.returncode == 1 and "Unknown package 'nowhere_msgs'" in unknown.stderr
+    finally:
+        stop_all(node)

@@ -28,6 +28,7 @@ NODES = [
     [{"name": "chatty", "publishers": [{"topic": "news", "type": "std_msgs/msg/String", "values": {"data": "hello"},
                                         "rate_hz": 10}]},
      {"name": "picky", "subscribers": [{"topic": "odd", "type": "std_msgs/msg/String", "reliability": "reliable"}]},
+     {"name": "_helper"},  # a hidden node: listed only after H
      {"name": "sloppy", "publishers": [{"topic": "odd", "type": "std_msgs/msg/String",
                                         "reliability": "best_effort"}]},
      {"name": "echoer", "services": [{"name": "echo_types", "type": "test_msgs/srv/BasicTypes", "echo": True}]},
@@ -237,9 +238,10 @@ def test_tab_keys_and_the_command_palette(graph) -> None:
             await pilot.press("shift+tab", "shift+tab")
             await until(pilot, lambda: tabs.active == "nodes")
             nodes = table(app, "#nodes-table")
+            assert "/_helper" not in nodes.rows_by_key
+            await pilot.press("H")  # hidden names too (never roc's own participants)
+            await until(pilot, lambda: "/_helper" in nodes.rows_by_key, what="hidden")
             assert not any(name.startswith("/_roc_") for name in nodes.rows_by_key)
-            await pilot.press("H")  # hidden names too: roc's daemon
-            await until(pilot, lambda: any(name.startswith("/_roc_") for name in nodes.rows_by_key), what="hidden")
             await pilot.press("colon")
             await until(pilot, lambda: type(app.screen).__name__ == "CommandPalette")
             await pilot.press(*"node motor_con")

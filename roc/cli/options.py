@@ -6,7 +6,8 @@ from __future__ import annotations
 import argparse
 
 # Options whose values are passed through to a tool and may themselves start with a dash.
-PASSTHROUGH_OPTIONS = ("--cmake-args", "--ament-cmake-args", "--ctest-args", "--pytest-args")
+# (--catkin-cmake-args too: roc rejects it, and its values must not be mistaken for options of roc)
+PASSTHROUGH_OPTIONS = ("--cmake-args", "--ament-cmake-args", "--ctest-args", "--pytest-args", "--catkin-cmake-args")
 
 
 def add_format_argument(parser: argparse.ArgumentParser, formats: tuple[str, ...] = ("text", "json")) -> None:
