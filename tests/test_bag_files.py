@@ -416,3 +416,40 @@ def test_list_names_formats():
     data = json.loads(result.stdout)
     assert [s["name"] for s in data["storage"]] == ["mcap", "sqlite3"]
     assert data["compressor"][0]["name"] == "zstd"
+
+
+# ---- roc interface show --bag: a type only a bag knows -------------------------------------------
+
+def test_interface_show_from_a_bag_matches_the_installed_definition(tmp_path: Path) -> None:
+    """A bag roc wrote holds the full definitions: shown from it, a type reads as from the ament index."""
+    write_test_msgs(tmp_path / "bag", rounds=1)
+    for options in ([], ["--no-comments"], ["--all-comments"]):
+        from_bag = roc("interface", "show", "test_msgs/msg/Nested", "--bag", str(tmp_path / "bag"), *options)
+        installed = roc("interface", "show", "test_msgs/msg/Nested", *options)
+        assert (from_bag.returncode, from_bag.stdout) == (0, installed.stdout), from_bag.stderr
+        assert "\tbool bool_value" in from_bag.stdout  # BasicTypes, from the bag's MSG: section
+
+
+def test_interface_show_of_a_type_only_a_bag_knows(tmp_path: Path) -> None:
+    from roc.bag.definitions import DELIMITER
+    from roc.bag.message import Definition
+
+    text = ("# A thing from a robot's own package\nstd_msgs/Header header\nPart[] parts # its parts\n"
+            f"{DELIMITER}MSG: robot_msgs/Part\nint32 count # how many\n")
+    writer = BagWriter(tmp_path / "bag", WriteOptions())
+    writer.add_topic(Topic("/thing", "robot_msgs/msg/Thing", "cdr", [QOS]),
+                     Definition("robot_msgs/msg/Thing", "ros2msg", text))
+    writer.write("/thing", b"\x00\x01\x00\x00", 1_000_000_000)
+    writer.close()
+    shown = roc("interface", "show", "robot_msgs/msg/Thing", "--bag", str(tmp_path / "bag"), "--no-comments")
+    assert (shown.returncode, shown.stdout) == (0, "std_msgs/Header header\n\tbuiltin_interfaces/Time stamp\n"
+                                                   "\t\tint32 sec\n\t\tuint32 nanosec\n\tstring frame_id\n"
+                                                   "Part[] parts #\n\tint32 count #\n"), shown.stderr  # ros2's lone '#'
+    part = roc("interface", "show", "robot_msgs/msg/Part", "--bag", str(tmp_path / "bag"), "--format", "json")
+    assert json.loads(part.stdout) | {"bag": None} == {"type": "robot_msgs/msg/Part", "file": None, "bag": None,
+                                                       "text": "int32 count # how many"}
+    assert roc("interface", "show", "robot_msgs/msg/Thing").returncode == 1  # not installed here
+    missing = roc("interface", "show", "robot_msgs/msg/Other", "--bag", str(tmp_path / "bag"))
+    assert (missing.returncode, missing.stdout) == (1, "")
+    assert missing.stderr == (f"roc: error: {tmp_path / 'bag'}: the bag holds no definition of robot_msgs/msg/Other "
+                              "(it holds: robot_msgs/msg/Part, robot_msgs/msg/Thing)\n")

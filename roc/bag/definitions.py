@@ -39,6 +39,29 @@ def _file(type_name: str, kind: str, suffix: str) -> str:
         raise _NotFound(type_name) from None
 
 
+def message_sections(definition: Definition) -> dict[str, str]:
+    """The ``.msg`` text of each type a ``ros2msg`` definition holds, by full name (``pkg/msg/Type``): its
+    own type's first, then each ``MSG:`` section's (empty for another encoding)."""
+    if definition.encoding != "ros2msg":
+        return {}
+    sections = {definition.type: ""}
+    current = definition.type
+    lines: list[str] = []
+    for line in definition.text.split("\n"):
+        if line == DELIMITER.rstrip("\n"):
+            continue
+        if line.startswith("MSG: "):
+            sections[current] = "\n".join(lines).strip("\n") + "\n"
+            name = line[len("MSG: "):].strip()
+            package, _, short = name.rpartition("/")
+            current = name if name.count("/") == 2 else f"{package}/msg/{short}"
+            lines = []
+            continue
+        lines.append(line)
+    sections[current] = "\n".join(lines).strip("\n") + "\n"
+    return sections
+
+
 def _raise(type_name: str) -> str:
     raise _NotFound(type_name)
 

@@ -59,7 +59,12 @@ def _inputs(root: Path, visited: list[str], packages: list[Package]) -> dict[str
     for package in packages:
         directory = str(root / package.path)
         inputs[directory] = _stamp(directory)
-        for name in IDENTIFICATION_FILES:
+        names: tuple[str, ...] = IDENTIFICATION_FILES
+        if package.manifest is not None and not os.path.exists(os.path.join(directory, "colcon.pkg")):
+            # a ROS package is read from its package.xml alone (a build file added or removed shows in
+            # the directory's mtime)
+            names = ("package.xml",)
+        for name in names:
             path = os.path.join(directory, name)
             if os.path.exists(path):
                 inputs[path] = _stamp(path)
@@ -82,6 +87,13 @@ def _unchanged(path: str, stamp: list[int] | None) -> bool:
     if stamp == [1]:  # an ignore marker: it must still be there
         return True
     return stamp is not None and info.st_mtime_ns == stamp[0] and info.st_size == stamp[1]
+
+
+def _compact(package: dict) -> dict:
+    """A package's cache entry with its manifest as marshal bytes, decoded only by a command that reads it."""
+    if package["manifest"] is not None:
+        package["manifest"] = marshal.dumps(package["manifest"])
+    return package
 
 
 def _condition_variables(packages: list[Package]) -> list[str]:
@@ -113,7 +125,7 @@ def cached_discovery(
         "inputs": _inputs(root, visited, packages),
         "conditions": {name: variables.get(name) for name in _condition_variables(packages)},
         "warnings": messages.emitted[first_warning:],
-        "packages": [p.to_dict() for p in packages],
+        "packages": [_compact(p.to_dict()) for p in packages],
     }
     try:
         write_bytes_atomic(path, marshal.dumps(data))

@@ -31,13 +31,13 @@ class Package:
     """
 
     def __init__(
-        self, name: str, path: Path, type: str, dependencies: dict[str, set[str]] | None = None,  # noqa: A002
+        self, name: str, path: Path | str, type: str, dependencies: dict[str, set[str]] | None = None,  # noqa: A002
         hooks: list[str] | None = None, metadata: dict[str, object] | None = None,
         constraints: dict[str, dict[str, str]] | None = None, group_depends: list[str] | None = None,
         member_of_groups: list[str] | None = None, manifest: Manifest | None = None,
     ):
         self.name = name
-        self.path = path
+        self._path: Path | str = path  # a str from the discovery cache, made a Path on first use
         self.type = type  # ros.ament_cmake, ros.ament_python, ros.cmake, ros.catkin, cmake, python, ...
         self.dependencies = dependencies if dependencies is not None else {}
         self.hooks = hooks if hooks is not None else []
@@ -46,20 +46,40 @@ class Package:
         self.group_depends = group_depends if group_depends is not None else []
         self.member_of_groups = member_of_groups if member_of_groups is not None else []
         self._manifest = manifest
-        self._manifest_data: dict | None = None  # from the cache, decoded on first use
+        # from the discovery cache, decoded on first use: a dict, or marshal bytes of one (a command that
+        # needs no manifest, such as `roc work list`, then never decodes a thousand of them)
+        self._manifest_data: dict | bytes | None = None
 
     @property
     def manifest(self) -> Manifest | None:  # noqa: F821
         if self._manifest is None and self._manifest_data is not None:
+            import marshal
+
             from roc.workspace.manifest import Manifest
 
-            self._manifest = Manifest.from_dict(self._manifest_data)
+            data = self._manifest_data
+            self._manifest = Manifest.from_dict(marshal.loads(data) if isinstance(data, bytes) else data)
             self._manifest_data = None
         return self._manifest
 
     @manifest.setter
     def manifest(self, value: Manifest | None) -> None:  # noqa: F821
         self._manifest, self._manifest_data = value, None
+
+    @property
+    def path(self) -> Path:
+        if not isinstance(self._path, Path):
+            self._path = Path(self._path)
+        return self._path
+
+    @path.setter
+    def path(self, value: Path) -> None:
+        self._path = value
+
+    @property
+    def path_text(self) -> str:
+        """``path`` as colcon prints it, without making a Path of a cached one."""
+        return self._path if isinstance(self._path, str) else str(self._path)
 
     def __repr__(self) -> str:
         return f"Package({self.name!r}, {str(self.path)!r}, {self.type!r})"
@@ -84,7 +104,7 @@ class Package:
     @classmethod
     def from_dict(cls, data: dict) -> Package:
         package = cls(
-            name=data["name"], path=Path(data["path"]), type=data["type"],
+            name=data["name"], path=data["path"], type=data["type"],
             dependencies={c: set(names) for c, names in data["dependencies"].items()},
             hooks=data["hooks"], metadata=data["metadata"], constraints=data["constraints"],
             group_depends=data["group_depends"], member_of_groups=data["member_of_groups"],

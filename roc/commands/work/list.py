@@ -26,13 +26,13 @@ def run(args: argparse.Namespace) -> int:
     if args.format == "json":
         if not args.topological_order:
             packages.sort(key=lambda p: p.name)
-        print_json([{"name": p.name, "path": str(p.path), "type": p.type} for p in packages])
+        print_json([{"name": p.name, "path": p.path_text, "type": p.type} for p in packages])
         return 0
     if args.names_only:
         lines = [p.name for p in packages]
     elif args.paths_only:
-        lines = [str(p.path) for p in packages]
+        lines = [p.path_text for p in packages]
     else:
-        lines = [f"{p.name}\t{p.path}\t({p.type})" for p in packages]
+        lines = [f"{p.name}\t{p.path_text}\t({p.type})" for p in packages]
     print_lines(lines if args.topological_order else sorted(lines))
     return 0
