@@ -55,13 +55,12 @@ def start_nodes(specs: list, env: dict[str, str]) -> list[subprocess.Popen]:
         processes.append(process)
     for process in processes:
         assert process.stdout.readline().strip() == "ready"
+        _lines(process)  # read from now on: a node that prints what it hears never blocks on a full pipe
     return processes
 
 
-def read_line(process: subprocess.Popen, timeout: float = 20.0) -> str | None:
-    """The next line of a process's stdout ("" once it has ended), or None when none came within
-    ``timeout`` seconds: a test that waits for output fails instead of hanging. Once used on a process,
-    read its stdout only through this."""
+def _lines(process: subprocess.Popen) -> queue.SimpleQueue:
+    """The lines of a process's stdout, read by a thread of their own from the first call on."""
     lines = getattr(process, "_roc_lines", None)
     if lines is None:
         lines = process._roc_lines = queue.SimpleQueue()
@@ -71,6 +70,14 @@ def read_line(process: subprocess.Popen, timeout: float = 20.0) -> str | None:
                 lines.put(line)
             lines.put("")
         threading.Thread(target=pump, daemon=True).start()
+    return lines
+
+
+def read_line(process: subprocess.Popen, timeout: float = 20.0) -> str | None:
+    """The next line of a process's stdout ("" once it has ended), or None when none came within
+    ``timeout`` seconds: a test that waits for output fails instead of hanging. Once used on a process,
+    read its stdout only through this."""
+    lines = _lines(process)
     try:
         return lines.get(timeout=max(0.01, timeout))
     except queue.Empty:

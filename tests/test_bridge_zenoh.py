@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 from build_helpers import ros_domain_id
-from graph_helpers import assert_call_and_goal_work, graph_env, roc, start_nodes, stop_all, threads
+from graph_helpers import assert_call_and_goal_work, graph_env, read_line, roc, start_nodes, stop_all, threads
 from test_bridge import _assert_each_arrived_once, _bridge, _hear_the_other_side, _line, _stop, _talker_and_listener
 
 pytestmark = pytest.mark.xdist_group("busy_or_timing")  # see scripts/test.sh
@@ -72,8 +72,8 @@ def _first_messages(process: subprocess.Popen, seconds: float = 40) -> dict[str,
     deadline = time.monotonic() + seconds
     while len(first) < len(PUBLISHED):
         assert time.monotonic() < deadline, first
-        line = process.stdout.readline()
-        assert line, f"the listener ended: {first}"
+        line = read_line(process, deadline - time.monotonic())
+        assert line, f"the listener ended or said nothing: {first}"
         printed = json.loads(line)
         first.setdefault(printed["topic"], printed["message"])
     return first
