@@ -8,6 +8,7 @@ from __future__ import annotations
 import asyncio
 import os
 import re
+import sys
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -56,6 +57,16 @@ def live_graph(env: dict[str, str], specs: list) -> Iterator[dict[str, str]]:
 def graph(tmp_path_factory):
     with live_graph(graph_env(36, tmp_path_factory.mktemp("runtime")), NODES) as env:
         yield env
+
+
+@pytest.fixture(autouse=True)
+def loads_no_rclpy_when_asked():
+    """With ROC_TUI_ASSERT_NO_RCLPY=1 (tests/test_tui_no_rclpy.py runs these tests in a fresh process so),
+    each test ends by checking that the app loaded no rclpy module."""
+    yield
+    if os.environ.get("ROC_TUI_ASSERT_NO_RCLPY") == "1":
+        loaded = sorted(name for name in sys.modules if name.split(".")[0] == "rclpy")
+        assert not loaded, f"roc tui loaded rclpy: {loaded[:5]}"
 
 
 async def until(pilot, condition: Callable[[], bool], timeout: float = 30.0, what: str = "") -> None:

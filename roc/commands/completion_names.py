@@ -45,20 +45,14 @@ def _params(connection: Connection, node: str | None) -> list[str]:
 
 
 def _frames(connection: Connection) -> list[str]:
-    """The frames /tf and /tf_static carry, heard for FRAMES_SECONDS."""
-    from roc.ros.cdr import decode
-    from roc.ros.types import TF_TYPE, UnknownTypeError, message_class
-
-    try:
-        message_class(TF_TYPE)
-    except UnknownTypeError:
-        return []
+    """The frames /tf and /tf_static carry, heard for FRAMES_SECONDS (the daemon decodes them; a daemon
+    without tf2_msgs answers with an error, which ``names`` turns into no names)."""
     frames: set[str] = set()
     deadline = time.monotonic() + FRAMES_SECONDS
     for event in connection.stream("frames", {}, timeout=TIMEOUT):
         for message in event.get("messages", ()):
-            for stamped in decode(TF_TYPE, message["data"]).transforms:
-                frames.update((stamped.header.frame_id.lstrip("/"), stamped.child_frame_id.lstrip("/")))
+            for parent, child, *_ in message["transforms"]:
+                frames.update((parent.lstrip("/"), child.lstrip("/")))
         if time.monotonic() >= deadline or event.get("final"):
             break
     return sorted(frames)

@@ -40,8 +40,6 @@ class Listener:
     def listen(self, done: Callable[[], bool] = lambda: False, seconds: float | None = None) -> bool:
         """Take in transforms until ``done()`` (True) or ``seconds`` have passed (False), counted from
         the subscription (a cold daemon takes a while to start)."""
-        from roc.ros.cdr import decode
-
         start = time.monotonic() if self._subscribed else None
         if done():
             return True
@@ -49,13 +47,11 @@ class Listener:
             if event["event"] == "subscribed":
                 self._subscribed, start = True, time.monotonic()
             for message in event.get("messages", ()):
-                for stamped in decode(TF_TYPE, message["data"]).transforms:
-                    stamp = stamped.header.stamp.sec * 1_000_000_000 + stamped.header.stamp.nanosec
-                    t, r = stamped.transform.translation, stamped.transform.rotation
+                for parent, child_frame, stamp, translation, rotation in message["transforms"]:
                     received = message["received"] or time.time_ns()
-                    self.buffer.add(stamped.header.frame_id, stamped.child_frame_id, stamp,
-                                    Transform((t.x, t.y, t.z), (r.x, r.y, r.z, r.w)), message["static"], received)
-                    child = stamped.child_frame_id.lstrip("/")
+                    self.buffer.add(parent, child_frame, stamp, Transform(tuple(translation), tuple(rotation)),
+                                    message["static"], received)
+                    child = child_frame.lstrip("/")
                     if message.get("publisher"):
                         self.publishers.setdefault(child, set()).add(message["publisher"])
                     if not message["static"]:

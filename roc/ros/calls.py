@@ -1,6 +1,7 @@
 """Service calls and action goals as streams of plain-data events (see roc.ros.dataplane): the request
-or goal travels as CDR, the client is created on the Graph's node and destroyed when the stream
-closes; a goal still running then is canceled."""
+or goal travels as CDR, or as plain data for a client that loads no rclpy (``roc tui``), which then gets
+the answers as plain data too (``value``); the client is created on the Graph's node and destroyed when
+the stream closes; a goal still running then is canceled."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from typing import Any
 from rclpy.serialization import deserialize_message
 
 from roc.ros.cdr import serialize
+from roc.ros.messages import fill_message, value_to_data
 from roc.ros.protocol import HEARTBEAT_SECONDS, Events
 from roc.ros.types import action_class, service_class
 
@@ -25,12 +27,28 @@ def _wait(done: Callable[[], bool]) -> Iterator[dict[str, Any]]:
         yield {"event": "heartbeat"}
 
 
+def _received(params: dict[str, Any], key: str, cls: Any) -> Any:
+    """The request or goal ``params[key]`` (base64 CDR), or ``params[key + "_data"]`` (plain data)."""
+    if f"{key}_data" in params:
+        return fill_message(cls, params[f"{key}_data"])
+    return deserialize_message(base64.b64decode(params[key]), cls)
+
+
+def _answer(params: dict[str, Any], message: Any) -> dict[str, Any]:
+    """A response, feedback or result: base64 CDR (``data``), and as plain data (``value``) for a
+    client that sent plain data."""
+    answer = {"data": base64.b64encode(serialize(message)).decode()}
+    if any(key.endswith("_data") for key in params):
+        answer["value"] = value_to_data(message)
+    return answer
+
+
 def call(graph, params: dict[str, Any]) -> Events:
-    """Call ``params["service"]`` (a ``type`` service) with ``request`` (base64 CDR): ``waiting`` while
-    no server is available, then ``request`` and ``response {data}`` per call; with ``rate`` (Hz) again
-    and again until closed."""
+    """Call ``params["service"]`` (a ``type`` service) with ``request`` (base64 CDR; or ``request_data``,
+    plain data): ``waiting`` while no server is available, then ``request`` and ``response {data,
+    value?}`` per call; with ``rate`` (Hz) again and again until closed."""
     cls = service_class(params["type"])
-    request = deserialize_message(base64.b64decode(params["request"]), cls.Request)
+    request = _received(params, "request", cls.Request)
     client = graph.node.create_client(cls, params["service"])
     try:
         if not client.wait_for_service(timeout_sec=0.1):
@@ -41,7 +59,7 @@ def call(graph, params: dict[str, Any]) -> Events:
             yield {"event": "request"}
             future = client.call_async(request)
             yield from _wait(partial(_done, future))
-            yield {"event": "response", "data": base64.b64encode(serialize(future.result())).decode()}
+            yield {"event": "response", **_answer(params, future.result())}
             if period is None:
                 return
             due += period
@@ -57,14 +75,15 @@ GOAL_STATUS = {0: "UNKNOWN", 1: "ACCEPTED", 2: "EXECUTING", 3: "CANCELING", 4: "
 
 
 def goal(graph, params: dict[str, Any]) -> Events:
-    """Send ``params["goal"]`` (base64 CDR of a ``type`` action's Goal) to ``action``: ``waiting``
+    """Send ``params["goal"]`` (base64 CDR of a ``type`` action's Goal; or ``goal_data``, plain data) to
+    ``action``: ``waiting``
     while no server is available, then ``accepted {goal_id}`` (or ``rejected``), ``feedback {data}``
     (with ``feedback``), and ``result {data, status}``. Closed before the result, the goal is
     canceled."""
     from rclpy.action import ActionClient
 
     cls = action_class(params["type"])
-    request = deserialize_message(base64.b64decode(params["goal"]), cls.Goal)
+    request = _received(params, "goal", cls.Goal)
     client = ActionClient(graph.node, cls, params["action"])
     handle = None
     try:
@@ -85,14 +104,14 @@ def goal(graph, params: dict[str, Any]) -> Events:
             finished = _done(result)
             while not feedback.empty():
                 message = feedback.get().feedback
-                yield {"event": "feedback", "data": base64.b64encode(serialize(message)).decode()}
+                yield {"event": "feedback", **_answer(params, message)}
             if finished:
                 break
             yield {"event": "heartbeat"}
         outcome = result.result()
         handle = None
-        yield {"event": "result", "data": base64.b64encode(serialize(outcome.result)).decode(),
-               "status": GOAL_STATUS.get(outcome.status, "UNKNOWN")}
+        status = GOAL_STATUS.get(outcome.status, "UNKNOWN")
+        yield {"event": "result", **_answer(params, outcome.result), "status": status}
     finally:
         if handle is not None:  # the client went away first: do not leave the goal running
             canceled = threading.Event()

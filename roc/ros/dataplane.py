@@ -26,8 +26,10 @@ from rclpy.qos import (
     QoSProfile,
     ReliabilityPolicy,
 )
+from rclpy.serialization import deserialize_message
 
 from roc.errors import RocError
+from roc.ros.messages import value_to_data
 from roc.ros.protocol import HEARTBEAT_SECONDS, Events, full_name
 from roc.ros.raw_subscription import Receiver, gid_text
 from roc.ros.types import TF_TYPE, message_class
@@ -115,7 +117,9 @@ def echo(graph, params: dict[str, Any]) -> Events:
     numbers say never arrived), ``{"event": "subscribed", "type"}`` first and heartbeats in between.
     Params: ``topic``, ``wait`` (seconds to wait for a publisher to be discovered), ``type`` (else the
     graph's), ``qos`` (see qos_profile), ``timeout`` (seconds for the first message, counted from the
-    start, the wait for a publisher included; then ``{"event": "timeout"}`` ends the stream)."""
+    start, the wait for a publisher included; then ``{"event": "timeout"}`` ends the stream),
+    ``latest_value`` (the last message of each event also as plain data, ``value``, its strings and
+    arrays cut after ``truncate_length`` elements: for a client that loads no rclpy)."""
     topic, timeout = params["topic"], params.get("timeout")
     started = time.monotonic()
     if timeout is not None:
@@ -145,6 +149,9 @@ def echo(graph, params: dict[str, Any]) -> Events:
                     last_sequence[gid] = sequence
                 messages.append({"data": base64.b64encode(data).decode(), "lost": max(lost, 0),
                                  "info": {key: value for key, value in info.items() if value is not None}})
+            if params.get("latest_value"):
+                messages[-1]["value"] = value_to_data(deserialize_message(batch[-1][1], cls),
+                                                      truncate_length=params.get("truncate_length"))
             yield {"event": "messages", "messages": messages}
     finally:
         receiver.close()
@@ -244,10 +251,11 @@ def stats(graph, params: dict[str, Any]) -> Events:
 def frames(graph, params: dict[str, Any]) -> Events:
     """Subscribe to /tf (QoS following the publishers known, else reliable as tf2's listener; depth
     100) and /tf_static (transient local, as tf2's static listener does) and yield ``messages
-    {messages: [{static, data, received, publisher}]}`` batches of TFMessage CDR (``publisher``: the
-    sending node's full name, null while the graph does not know it), ``subscribed`` first and
-    heartbeats in between. It needs no discovered graph: with ``early``, a daemon that is starting
-    serves it before its discovery period."""
+    {messages: [{static, transforms, received, publisher}]}`` batches (``transforms``: each of the
+    TFMessage's ``[parent, child, stamp_ns, [x, y, z], [qx, qy, qz, qw]]``, decoded here so that the
+    client loads no rclpy; ``publisher``: the sending node's full name, null while the graph does not
+    know it), ``subscribed`` first and heartbeats in between. It needs no discovered graph: with
+    ``early``, a daemon that is starting serves it before its discovery period."""
     cls = message_class(TF_TYPE)
     dynamic = qos_profile({"profile": "default", "depth": 100}, graph.node.get_publishers_info_by_topic("/tf"))
     static = qos_profile({"profile": "default", "depth": 100, "durability": "transient_local",
@@ -259,12 +267,22 @@ def frames(graph, params: dict[str, Any]) -> Events:
         receiver.subscribe("/tf_static", cls, "/tf_static", static)
         yield {"event": "subscribed", "type": TF_TYPE}
         while True:
-            messages = [{"static": topic == "/tf_static", "data": base64.b64encode(data).decode(),
+            messages = [{"static": topic == "/tf_static", "transforms": _transforms(deserialize_message(data, cls)),
                          "received": info["received_timestamp"], "publisher": nodes.name(str(topic), info["gid"])}
                         for topic, data, info in receiver.batch(HEARTBEAT_SECONDS, MAX_BATCH)]
             yield {"event": "messages", "messages": messages} if messages else {"event": "heartbeat"}
     finally:
         receiver.close()
+
+
+def _transforms(message: Any) -> list[list]:
+    """A TFMessage's transforms as ``[parent, child, stamp_ns, [x, y, z], [qx, qy, qz, qw]]``."""
+    found = []
+    for stamped in message.transforms:
+        t, r, stamp = stamped.transform.translation, stamped.transform.rotation, stamped.header.stamp
+        found.append([stamped.header.frame_id, stamped.child_frame_id, stamp.sec * 1_000_000_000 + stamp.nanosec,
+                      [t.x, t.y, t.z], [r.x, r.y, r.z, r.w]])
+    return found
 
 
 class PublisherNames:

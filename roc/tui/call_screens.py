@@ -88,21 +88,21 @@ class ServiceScreen(CallScreen):
         request = self.message(cls.Request)
         if request is not None:
             self.say("calling...", restart=True)
-            self.call(cls, request)
+            self.call(request)
 
     @work(thread=True, exclusive=True, group="call")
-    def call(self, cls, request) -> None:
-        from roc.ros.cdr import decode, encode
-        from roc.ros.messages import message_to_yaml
+    def call(self, request) -> None:
+        from roc.ros.messages import dict_to_yaml, value_to_data
 
         worker = get_current_worker()
-        params = {"service": self.target, "type": self.type_name, "request": encode(request), "rate": None}
+        # plain data both ways: the daemon fills the request and decodes the response (no rclpy here)
+        params = {"service": self.target, "type": self.type_name, "request_data": value_to_data(request), "rate": None}
         try:
             for event in host(self).feed.stream("call", params, lambda: worker.is_cancelled):
                 if event["event"] == "waiting":
                     self.app.call_from_thread(self.say, "waiting for the service to be available...")
                 elif event["event"] == "response":
-                    text = message_to_yaml(decode(cls.Response, event["data"]))
+                    text = dict_to_yaml(event["value"])
                     self.app.call_from_thread(self.say, f"response:\n{text}", True)
         except RocError as error:
             self.app.call_from_thread(self.say, f"error: {error}")
@@ -128,15 +128,14 @@ class ActionScreen(CallScreen):
         goal = self.message(cls.Goal)
         if goal is not None:
             self.say("sending the goal...", restart=True)
-            self.send(cls, goal)
+            self.send(goal)
 
     @work(thread=True, exclusive=True, group="goal")
-    def send(self, cls, goal) -> None:
-        from roc.ros.cdr import decode, encode
-        from roc.ros.messages import message_to_yaml
+    def send(self, goal) -> None:
+        from roc.ros.messages import dict_to_yaml, value_to_data
 
         worker = get_current_worker()
-        params = {"action": self.target, "type": self.type_name, "goal": encode(goal), "feedback": True}
+        params = {"action": self.target, "type": self.type_name, "goal_data": value_to_data(goal), "feedback": True}
         say = self.app.call_from_thread
         try:
             for event in host(self).feed.stream("goal", params, lambda: worker.is_cancelled):
@@ -149,10 +148,10 @@ class ActionScreen(CallScreen):
                 elif kind == "rejected":
                     say(self.say, "goal rejected")
                 elif kind == "feedback":
-                    say(self.say, f"feedback: {message_to_yaml(decode(cls.Feedback, event['data']), flow_style=True)}")
+                    say(self.say, f"feedback: {dict_to_yaml(event['value'], flow_style=True)}")
                 elif kind == "result":
                     self.goal_id = None
-                    result = message_to_yaml(decode(cls.Result, event["data"]), flow_style=True)
+                    result = dict_to_yaml(event["value"], flow_style=True)
                     say(self.say, f"result ({event['status']}): {result}")
         except RocError as error:
             say(self.say, f"error: {error}")
@@ -171,7 +170,7 @@ class ActionScreen(CallScreen):
         try:
             for event in host(self).feed.stream("call", cancel_call(self.target, goal_id), lambda: False):
                 if event["event"] == "response":
-                    accepted = cancel_accepted(event["data"])
+                    accepted = cancel_accepted(event)
                     self.app.call_from_thread(self.say, "cancel accepted" if accepted else "cancel refused")
                     return
         except RocError as error:

@@ -21,6 +21,8 @@ from roc.ros.rates import Sample, Window
 from roc.tui.model import TOPIC_WINDOW, Row, bandwidth_text, diagnoses, endpoint_cells, rate_text, shown_endpoints
 from roc.tui.widgets import ListTable, Prompt, host
 
+TRUNCATE_LENGTH = 128  # arrays and strings shown in the echo pane are cut after this many elements
+
 ECHO_SECONDS = 0.25  # the echo pane shows the latest message at most this often
 
 
@@ -106,7 +108,9 @@ class TopicScreen(Screen):
     def echo(self) -> None:
         worker = get_current_worker()
         try:
-            for event in host(self).feed.stream("echo", {"topic": self.topic, "wait": 0}, lambda: worker.is_cancelled):
+            # the daemon decodes the last message of each batch (``value``): no rclpy in this process
+            params = {"topic": self.topic, "wait": 0, "latest_value": True, "truncate_length": TRUNCATE_LENGTH}
+            for event in host(self).feed.stream("echo", params, lambda: worker.is_cancelled):
                 if event["event"] == "subscribed":
                     self.type_name = event["type"]
                 elif event["event"] == "messages":
@@ -134,17 +138,22 @@ class TopicScreen(Screen):
         elif not force:
             return
         if self.shown is not None:
-            self.query_one("#echo", Static).update(Text(self.message_text(self.shown["data"])))
+            self.query_one("#echo", Static).update(Text(self.message_text(self.shown["value"])))
 
-    def message_text(self, data: str) -> str:
-        from roc.ros.cdr import decode  # rclpy's serialisation: loaded only for an echo
-        from roc.ros.messages import echo_text, get_field
+    def message_text(self, value: Any) -> str:
+        """The message (as the daemon decoded it) or the selected field, as ``roc topic echo`` prints it."""
+        from roc.ros.messages import dict_to_yaml, field_names
 
         try:
-            message = decode(self.type_name or "", data)
-            return echo_text(get_field(message, self.field) if self.field else message, truncate_length=128)
+            names = field_names(self.field) if self.field else []
         except RocError as error:
             return f"cannot show the message: {error}"
+        for depth, name in enumerate(names):
+            if not isinstance(value, dict) or name not in value:
+                known = ", ".join(value) if isinstance(value, dict) else "it is no message"
+                return f"cannot show the message: {'.'.join(names[:depth + 1])}: no such field ({known})"
+            value = value[name]
+        return dict_to_yaml(value) + "---\n" if isinstance(value, dict) else f"{value}\n---\n"
 
     def action_pause(self) -> None:
         self.paused = not self.paused

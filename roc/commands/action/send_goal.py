@@ -98,24 +98,16 @@ def _interruptible():
 
 
 def cancel_call(action_name: str, goal_id: str) -> dict:
-    """The ``call`` stream's params that ask the action's cancel service to cancel the goal."""
-    from action_msgs.srv import CancelGoal
-
-    from roc.ros.cdr import encode
-
-    request = CancelGoal.Request()
-    request.goal_info.goal_id.uuid = list(bytes.fromhex(goal_id))
+    """The ``call`` stream's params that ask the action's cancel service to cancel the goal (as plain
+    data: the daemon fills the request and answers with plain data too)."""
     return {"service": f"{action_name}/_action/cancel_goal", "type": "action_msgs/srv/CancelGoal",
-            "request": encode(request)}
+            "request_data": {"goal_info": {"goal_id": {"uuid": list(bytes.fromhex(goal_id))}}}}
 
 
-def cancel_accepted(data: str) -> bool:
-    """Whether the cancel service's response (base64 CDR) says the goal is being canceled."""
-    from action_msgs.srv import CancelGoal
-
-    from roc.ros.cdr import decode
-
-    return bool(decode(CancelGoal.Response, data).goals_canceling)
+def cancel_accepted(response: dict) -> bool:
+    """Whether the cancel service's response (a ``call`` stream's ``response`` event) says the goal is
+    being canceled."""
+    return bool(response["value"]["goals_canceling"])
 
 
 def _cancel(args: argparse.Namespace, goal_id: str) -> None:
@@ -123,5 +115,5 @@ def _cancel(args: argparse.Namespace, goal_id: str) -> None:
     print_text("Canceling goal...\n")
     for event in stream("call", cancel_call(args.action_name, goal_id), use_daemon=not args.no_daemon):
         if event["event"] == "response":
-            print_text("Goal canceled.\n" if cancel_accepted(event["data"]) else "Failed to cancel goal\n")
+            print_text("Goal canceled.\n" if cancel_accepted(event) else "Failed to cancel goal\n")
             return
