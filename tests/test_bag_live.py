@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import pty
+import re
 import resource
 import signal
 import subprocess
@@ -286,3 +287,76 @@ def test_play_options_select_rename_cut_and_clock(tmp_path):
 
     assert [deserialize_message(d, String).data for d in found["/renamed"]] == [f"/a {i}" for i in range(20, 71)]
     assert found["/clock"]
+
+
+def test_arrow_keys_step_and_change_the_rate_and_a_sim_time_recording_takes_the_clock(tmp_path):
+    """On a terminal, paused: the right arrow plays one message each, up and down change the rate by 10 %,
+    space resumes. A recorder with --use-sim-time writes each message at the time of the player's /clock
+    (the bag's own times, years before now), not at its wall clock."""
+    from rclpy.serialization import serialize_message
+    from std_msgs.msg import String
+
+    from roc.bag.definitions import definition
+    from roc.bag.metadata import Topic
+    from roc.bag.qos import default_profile
+    from roc.bag.writer import BagWriter, WriteOptions
+
+    writer = BagWriter(tmp_path / "source", WriteOptions())
+    writer.add_topic(Topic("/a", "std_msgs/msg/String", "cdr", [default_profile()]), definition("std_msgs/msg/String"))
+    start_ns = 1_600_000_000_000_000_000  # September 2020
+    for index in range(40):
+        writer.write("/a", serialize_message(String(data=f"{index}")), start_ns + index * 20_000_000)
+    writer.close()
+    env = graph_env(34, tmp_path)
+    listener = start_nodes([{"name": "listener", "subscribers": [{"topic": "a", "type": "std_msgs/msg/String",
+                                                                 "print": True}]}], env)[0]
+    wall = roc_process("bag", "record", "/a", "-o", "wall", env=env, cwd=tmp_path)
+    simulated = roc_process("bag", "record", "/a", "--use-sim-time", "-o", "sim", env=env, cwd=tmp_path)
+    controller, terminal = pty.openpty()
+    player = None
+    try:
+        player = start([str(BIN / "roc"), "bag", "play", "-p", "--clock", "200", "--wait-for-all-acked", "10000",
+                        str(tmp_path / "source")], env, tmp_path, stdin=terminal)
+        wait_for_line(player, "Paused")
+        wait_subscribed(wall, ["/a"])  # the recorders find /a once the player advertises it
+        wait_subscribed(simulated, ["/a"])
+        first = None
+        while first is None:  # right arrow: one message; pressed until the listener has matched the player
+            os.write(controller, b"\x1b[C")
+            first = _heard_index(listener, 2.0)
+        for _ in range(2):
+            os.write(controller, b"\x1b[C")
+        assert [_heard_index(listener, 10.0), _heard_index(listener, 10.0)] == [first + 1, first + 2]
+        assert _heard_index(listener, 1.0) is None  # paused: nothing more
+        os.write(controller, b"\x1b[A")  # up: 10 % faster
+        assert "Rate: 1.100" in wait_for_line(player, "Rate:")[-1]
+        os.write(controller, b"\x1b[B\x1b[B")  # down twice
+        wait_for_line(player, "Rate:")
+        assert "Rate: 0.909" in wait_for_line(player, "Rate:")[-1]
+        os.write(controller, b" ")
+        output = "".join(wait_for_line(player, "Played", timeout=60))
+        assert "Played 40 messages on 1 topics" in output, output
+        assert player.wait(timeout=60) == 0, player.stderr.read()
+        interrupt(wall)
+        interrupt(simulated)
+    finally:
+        os.close(controller)
+        os.close(terminal)
+        for process in (player, wall, simulated, listener):
+            if process is not None:
+                stop_process(process)
+    with Bag(tmp_path / "wall") as bag:
+        wall_times = [m.log_time for m in bag.messages()]
+    assert len(wall_times) == 40 and min(wall_times) > start_ns + 10**17  # now, not 2020
+    with Bag(tmp_path / "sim") as bag:
+        sim_times = [m.log_time for m in bag.messages()]
+    # stamped with /clock: within the bag's own span (messages before the first /clock are left out)
+    assert sim_times and all(start_ns <= t <= start_ns + 40 * 20_000_000 + 10**9 for t in sim_times), sim_times[:3]
+
+
+def _heard_index(listener: subprocess.Popen, timeout: float) -> int | None:
+    """The index (the String's data) of the next message the listener node printed, None if none came."""
+    line = read_line(listener, timeout)
+    if not line:
+        return None
+    return int(re.search(r"data='(\d+)'", line).group(1))
