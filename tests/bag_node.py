@@ -16,7 +16,7 @@ import rclpy
 from bag_helpers import filled, load
 from rclpy.duration import Duration
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, qos_profile_system_default
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 
 def publish(node: Node, count: int, rate: float, types: list[str]) -> None:
@@ -44,7 +44,10 @@ def service(node: Node, count: int) -> None:
         return response
 
     server = node.create_service(SetBool, "/toggle", answer)
-    server.configure_introspection(node.get_clock(), qos_profile_system_default, ServiceIntrospectionState.CONTENTS)
+    # events kept for a late subscriber (the recorder matches the event publisher only a moment after it
+    # has subscribed), and the recorder adapts to that QoS
+    kept = QoSProfile(depth=100, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE)
+    server.configure_introspection(node.get_clock(), kept, ServiceIntrospectionState.CONTENTS)
     client = node.create_client(SetBool, "/toggle")
     executor = SingleThreadedExecutor()
     executor.add_node(node)

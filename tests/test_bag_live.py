@@ -264,9 +264,11 @@ def test_play_options_select_rename_cut_and_clock(tmp_path):
     from roc.bag.writer import BagWriter, WriteOptions
 
     writer = BagWriter(tmp_path / "source", WriteOptions())
+    # transient local with room for every message: a recorder whose subscription the player matches a
+    # moment after it resumed still gets the first messages (as the recorder adapts to the offered QoS)
+    kept = {**default_profile(), "durability": "transient_local", "depth": 1000}
     for name in ("/a", "/b"):
-        writer.add_topic(Topic(name, "std_msgs/msg/String", "cdr", [default_profile()]),
-                         definition("std_msgs/msg/String"))
+        writer.add_topic(Topic(name, "std_msgs/msg/String", "cdr", [kept]), definition("std_msgs/msg/String"))
     start_ns = 1_700_000_000_000_000_000
     for index in range(100):
         for name in ("/a", "/b"):

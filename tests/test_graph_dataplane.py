@@ -131,8 +131,15 @@ def test_ctrl_c_leaves_no_subscription_in_the_daemon(graph) -> None:
         pytest.skip(f"the ros2 CLI oracle is not available: {reason}")
 
     def subscribers() -> int:
-        info = ros2("topic", "info", "/chatter", env=env)
-        return int(next(line for line in info.stdout.splitlines() if line.startswith("Subscription count:")).split()[-1])
+        """The count ros2 prints (asked again when its daemon did not know /chatter yet, as happens)."""
+        deadline = time.monotonic() + 20
+        while True:
+            info = ros2("topic", "info", "/chatter", env=env)
+            counts = [line for line in info.stdout.splitlines() if line.startswith("Subscription count:")]
+            if counts:
+                return int(counts[0].split()[-1])
+            assert time.monotonic() < deadline, info.stdout + info.stderr
+            time.sleep(0.5)
 
     before = subscribers()
     echo = subprocess.Popen([str(BIN / "roc"), "topic", "echo", "/chatter"], env=env, stdout=subprocess.PIPE,
