@@ -78,10 +78,11 @@ def messages(bag_path: Path) -> dict[str, list[bytes]]:
 def play_when_recorder_listens(bag: Path, recorder: subprocess.Popen, topics: list[str], env: dict, cwd: Path,
                                *options: str) -> str:
     """Play ``bag`` started paused on a terminal, press space once the recorder subscribed to every
-    topic, and return the player's output when it ends."""
+    topic (and, --wait-for-subscribers, the player matched each subscription), and return the
+    player's output when it ends."""
     controller, terminal = pty.openpty()
-    player = start([str(BIN / "roc"), "bag", "play", "-p", "--wait-for-all-acked", "10000", *options, str(bag)],
-                   env, cwd, stdin=terminal)
+    player = start([str(BIN / "roc"), "bag", "play", "-p", "--wait-for-subscribers", "--wait-for-all-acked", "10000",
+                    *options, str(bag)], env, cwd, stdin=terminal)
     os.close(terminal)
     try:
         wait_for_line(player, "Paused")
@@ -264,11 +265,9 @@ def test_play_options_select_rename_cut_and_clock(tmp_path):
     from roc.bag.writer import BagWriter, WriteOptions
 
     writer = BagWriter(tmp_path / "source", WriteOptions())
-    # transient local with room for every message: a recorder whose subscription the player matches a
-    # moment after it resumed still gets the first messages (as the recorder adapts to the offered QoS)
-    kept = {**default_profile(), "durability": "transient_local", "depth": 1000}
     for name in ("/a", "/b"):
-        writer.add_topic(Topic(name, "std_msgs/msg/String", "cdr", [kept]), definition("std_msgs/msg/String"))
+        writer.add_topic(Topic(name, "std_msgs/msg/String", "cdr", [default_profile()]),
+                         definition("std_msgs/msg/String"))
     start_ns = 1_700_000_000_000_000_000
     for index in range(100):
         for name in ("/a", "/b"):
@@ -317,8 +316,9 @@ def test_arrow_keys_step_and_change_the_rate_and_a_sim_time_recording_takes_the_
     controller, terminal = pty.openpty()
     player = None
     try:
+        # three subscribers of /a: the listener and both recorders, each matched before anything plays
         player = start([str(BIN / "roc"), "bag", "play", "-p", "--clock", "200", "--wait-for-all-acked", "10000",
-                        str(tmp_path / "source")], env, tmp_path, stdin=terminal)
+                        "--wait-for-subscribers", "3", str(tmp_path / "source")], env, tmp_path, stdin=terminal)
         wait_for_line(player, "Paused")
         wait_subscribed(wall, ["/a"])  # the recorders find /a once the player advertises it
         wait_subscribed(simulated, ["/a"])
@@ -362,3 +362,37 @@ def _heard_index(listener: subprocess.Popen, timeout: float) -> int | None:
     if not line:
         return None
     return int(re.search(r"data='(\d+)'", line).group(1))
+
+
+def test_wait_for_subscribers_holds_playback_until_each_topic_is_heard(tmp_path):
+    """--wait-for-subscribers: a bag of volatile messages played before anyone listens would be lost;
+    the player waits, and a listener that comes a few seconds later hears every message."""
+    from rclpy.serialization import serialize_message
+    from std_msgs.msg import String
+
+    from roc.bag.definitions import definition
+    from roc.bag.metadata import Topic
+    from roc.bag.qos import default_profile
+    from roc.bag.writer import BagWriter, WriteOptions
+
+    writer = BagWriter(tmp_path / "source", WriteOptions())
+    writer.add_topic(Topic("/a", "std_msgs/msg/String", "cdr", [default_profile()]), definition("std_msgs/msg/String"))
+    for index in range(20):
+        writer.write("/a", serialize_message(String(data=f"{index}")), 1_700_000_000_000_000_000 + index * 5_000_000)
+    writer.close()
+    env = graph_env(35, tmp_path)
+    player = roc_process("bag", "play", "--wait-for-subscribers", "--wait-for-all-acked", "10000",
+                         "--disable-keyboard-controls", str(tmp_path / "source"), env=env, cwd=tmp_path)
+    listener = None
+    try:
+        wait_for_line(player, "Waiting for a subscriber on each of 1 topics")
+        assert read_line(player, 2.0) is None  # nothing played, nobody listens
+        listener = start_nodes([{"name": "listener", "subscribers": [
+            {"topic": "a", "type": "std_msgs/msg/String", "depth": 100, "print": True}]}], env)[0]
+        assert "Played 20 messages on 1 topics" in "".join(wait_for_line(player, "Played", timeout=60))
+        assert player.wait(timeout=30) == 0, player.stderr.read()
+        assert [_heard_index(listener, 10.0) for _ in range(20)] == list(range(20))
+    finally:
+        for process in (player, listener):
+            if process is not None:
+                stop_process(process)

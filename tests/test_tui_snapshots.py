@@ -10,6 +10,7 @@ from __future__ import annotations
 import asyncio
 import os
 import re
+import time
 from pathlib import Path
 
 import pytest
@@ -33,6 +34,7 @@ pytestmark = pytest.mark.slow
 SNAPSHOTS = Path(__file__).resolve().parent / "data" / "tui"
 IMAGES = REPO / "docs" / "images"
 UPDATE = os.environ.get("ROC_UPDATE_SNAPSHOTS") == "1"
+SETTLE_SECONDS = 5.0
 EXTRA = [[{"name": "camera", "namespace": "/robot1",
            "publishers": [{"topic": "image", "type": "sensor_msgs/msg/Image", "reliability": "best_effort",
                            "values": {"height": 2, "width": 2, "encoding": "mono8", "step": 2,
@@ -56,10 +58,16 @@ def graph(tmp_path_factory):
         yield env
 
 
-def check(app, name: str) -> None:
-    """Compare the screen with the stored snapshot (or store it, with ROC_UPDATE_SNAPSHOTS=1)."""
-    svg = app.export_screenshot(title="roc tui")
+async def check(app, pilot, name: str) -> None:
+    """Compare the screen with the stored snapshot (or store it, with ROC_UPDATE_SNAPSHOTS=1). A
+    loaded machine may draw a table's new column widths a moment after their rows, so the screen is
+    taken again, for up to SETTLE_SECONDS, until it matches."""
     stored = SNAPSHOTS / f"{name}.svg"
+    deadline = time.monotonic() + SETTLE_SECONDS
+    svg = app.export_screenshot(title="roc tui")
+    while not UPDATE and stored.is_file() and svg != stored.read_text() and time.monotonic() < deadline:
+        await pilot.pause(0.2)
+        svg = app.export_screenshot(title="roc tui")
     if UPDATE:
         stored.parent.mkdir(parents=True, exist_ok=True)
         stored.write_text(svg)
@@ -96,13 +104,13 @@ def test_main_screens(graph) -> None:
             topics = table(app, "#topics-table")
             topics.move_cursor(row=list(topics.rows_by_key).index("/robot1/image"))
             await pilot.pause(0.3)
-            check(app, "topics")
+            await check(app, pilot, "topics")
             await pilot.press("1")
             await pilot.pause(0.3)
-            check(app, "nodes")
+            await check(app, pilot, "nodes")
             await pilot.press("question_mark")
             await until(pilot, lambda: type(app.screen).__name__ == "TextViewer")
-            check(app, "help")
+            await check(app, pilot, "help")
             await pilot.press("escape")
             await open_row(app, pilot, "nodes", "/motor_controller")
             parameters = table(app, "#parameters")
@@ -111,7 +119,7 @@ def test_main_screens(graph) -> None:
             await until(pilot, lambda: parameters.columns[ColumnKey("parameter")].content_width >= widest,
                         what="the columns' widths")
             await pilot.pause(0.5)
-            check(app, "node")
+            await check(app, pilot, "node")
     asyncio.run(test())
 
 
@@ -140,7 +148,7 @@ def test_build_screen() -> None:
             await until(pilot, lambda: len(tasks.rows_by_key) == 4)
             tasks.move_cursor(row=2)
             await pilot.pause(0.6)
-            check(app, "build")
+            await check(app, pilot, "build")
             await pilot.press("enter")
             await until(pilot, lambda: type(app.screen).__name__ == "TextViewer")
             assert "expected ';'" in app.screen.query_one("#viewer").text

@@ -30,6 +30,9 @@ from roc.ros.types import UnknownTypeError, message_class
 SPIN_NS = 100_000  # the last 0.1 ms before a message is due is waited without sleeping (sleep overshoots)
 SLICE_S = 0.05  # a long wait is cut in slices, to notice a pause, a rate change or a stop
 RATE_STEP = 1.1  # up/down arrow: rate times or divided by this
+# DDS matches each side on its own: a new subscriber's reader, matched by the player's writer, may need a
+# moment more to match the writer in turn, and a volatile reader drops what came before it did
+MATCH_GRACE_S = 0.5
 CLOCK_TOPIC = "/clock"
 
 
@@ -50,6 +53,7 @@ class PlayOptions:
     read_ahead: int = 1000
     start_paused: bool = False
     wait_for_all_acked: int = -1  # ms to wait at the end for reliable subscribers to have it all (0: forever)
+    wait_for_subscribers: int = 0  # play nothing before every topic played has this many subscribers
 
 
 @dataclass
@@ -216,6 +220,8 @@ class Player:
                                     else None, options.playback_until if options.playback_until >= 0 else None)
                         if t is not None]
                 end = min(ends) if ends else None
+                if options.wait_for_subscribers > 0 and not self._wait_for_subscribers(publishers):
+                    return PlayResult(published, lateness, skipped)
                 with self._changed:
                     self._anchor(start)
                 if options.clock_hz > 0:
@@ -233,6 +239,22 @@ class Player:
                 self.stop()
                 graph.close()
         return PlayResult(published, lateness, skipped)
+
+    def _wait_for_subscribers(self, publishers: dict[str, Any]) -> bool:
+        """Wait until each publisher has matched as many subscriptions as asked (its own count, not the
+        graph's: a subscription another node already sees may not have matched the player yet), then
+        MATCH_GRACE_S more; False if stopped."""
+        wanted = self.options.wait_for_subscribers
+        waiting = sorted(publishers)
+        self._report(f"Waiting for {'a subscriber' if wanted == 1 else f'{wanted} subscribers'} on each of "
+                     f"{len(waiting)} topics")
+        with self._changed:
+            while waiting and not self._stopping:
+                waiting = [name for name in waiting if publishers[name].get_subscription_count() < wanted]
+                if waiting:
+                    self._changed.wait(SLICE_S)
+            self._changed.wait_for(lambda: self._stopping, MATCH_GRACE_S)
+            return not self._stopping
 
     def _wait_for_acks(self, publishers) -> None:
         from rclpy.duration import Duration

@@ -35,6 +35,12 @@ def _not_negative(text: str) -> float:
     return value
 
 
+def _count(text: str) -> int:
+    if not text.isdigit() or int(text) < 1:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a whole number of at least 1")
+    return int(text)
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("bag_path", metavar="BAG", help="a bag directory, or a .mcap or .db3 file")
     parser.add_argument("-s", "--storage", choices=sorted(STORAGES), help="storage of the bag (default: found)")
@@ -66,6 +72,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--wait-for-all-acked", type=int, default=-1, metavar="MS",
                         help="at the end, wait up to MS ms until reliable subscribers acknowledged every message "
                              "(0: as long as it takes; default: do not wait)")
+    parser.add_argument("--wait-for-subscribers", type=_count, nargs="?", const=1, default=0, metavar="N",
+                        help="play nothing until every topic played has at least N subscribers (default 1)")
     parser.add_argument("-p", "--start-paused", action="store_true", help="start paused (space resumes)")
     parser.add_argument("--disable-keyboard-controls", action="store_true", help="no keyboard controls")
 
@@ -119,7 +127,7 @@ def run(args: argparse.Namespace) -> int:
         delay=args.delay, playback_duration=args.playback_duration,
         playback_until=int(args.playback_until_sec * 1e9) if args.playback_until_sec >= 0 else -1,
         read_ahead=args.read_ahead_queue_size, start_paused=args.start_paused,
-        wait_for_all_acked=args.wait_for_all_acked),
+        wait_for_all_acked=args.wait_for_all_acked, wait_for_subscribers=args.wait_for_subscribers),
         report=lambda line: print_text(line + "\n"),
         warn=lambda line: print_text(f"roc: warning: {line}\n", sys.stderr))
     for number in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
