@@ -1,5 +1,5 @@
-"""Helpers for the bag tests: messages of any type with every field set to a non-default value, and a
-publisher process that sends them."""
+"""Helpers for the bag tests: messages of any type with every field set to a non-default value, a
+publisher process that sends them, and a bag of a type no installed package has."""
 
 from __future__ import annotations
 
@@ -56,3 +56,40 @@ def filled(cls: type, seed: int = 1) -> Any:
             value = array.array(current.typecode, value)
         setattr(message, name, value)
     return message
+
+
+# A message type no installed package has, as a bag recorded elsewhere holds it: its CDR is that of
+# geometry_msgs/msg/Vector3Stamped (a header and three float64), its definition the bag's own.
+BAG_ONLY_TYPE = "bagonly_msgs/msg/Stamped"
+BAG_ONLY_DEFINITION = (
+    "std_msgs/Header header\nbagonly_msgs/Vec3 vec # three numbers\n"
+    "================================================================================\n"
+    "MSG: bagonly_msgs/Vec3\nfloat64 x\nfloat64 y\nfloat64 z\n"
+    "================================================================================\n"
+    "MSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n"
+    "================================================================================\n"
+    "MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n")
+
+
+def write_bag_only_bag(path, count: int, definition: str = BAG_ONLY_DEFINITION) -> list[bytes]:
+    """A bag of ``count`` messages of BAG_ONLY_TYPE on /vec, 10 ms apart; returns their CDR."""
+    from geometry_msgs.msg import Vector3Stamped
+    from rclpy.serialization import serialize_message
+
+    from roc.bag.message import Definition
+    from roc.bag.metadata import Topic
+    from roc.bag.qos import default_profile
+    from roc.bag.writer import BagWriter, WriteOptions
+
+    writer = BagWriter(path, WriteOptions())
+    writer.add_topic(Topic("/vec", BAG_ONLY_TYPE, "cdr", [default_profile()]),
+                     Definition(BAG_ONLY_TYPE, "ros2msg", definition))
+    data = []
+    for index in range(count):
+        message = Vector3Stamped()
+        message.header.frame_id = f"frame {index}"
+        message.vector.x, message.vector.z = float(index), -1.5
+        data.append(serialize_message(message))
+        writer.write("/vec", data[-1], 1_700_000_000_000_000_000 + index * 10_000_000)
+    writer.close()
+    return data

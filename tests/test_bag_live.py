@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from bag_helpers import TEST_MSGS, filled, load
+from bag_helpers import BAG_ONLY_TYPE, TEST_MSGS, filled, load, write_bag_only_bag
 from build_helpers import BIN, stop_process
 from graph_helpers import graph_env, read_line, start_nodes
 
@@ -396,3 +396,40 @@ def test_wait_for_subscribers_holds_playback_until_each_topic_is_heard(tmp_path)
         for process in (player, listener):
             if process is not None:
                 stop_process(process)
+
+
+def test_a_type_only_the_bag_defines_is_built_once_and_played(tmp_path):
+    """A bag of a type no installed package has: the player builds it from the bag's own definitions
+    into roc's cache (once), starts again with it sourced and plays; a recorder that has the built
+    type gets the same bytes. A second play builds nothing."""
+    from roc.bag.built_types import environment_with
+    from roc.ros.types import UnknownTypeError, message_class
+
+    with pytest.raises(UnknownTypeError):
+        message_class(BAG_ONLY_TYPE)
+    sent = write_bag_only_bag(tmp_path / "source", 10)
+    env = graph_env(35, tmp_path, ROC_CACHE_DIR=str(tmp_path / "cache"))
+    player = roc_process("bag", "play", "--wait-for-subscribers", "--wait-for-all-acked", "10000",
+                         "--disable-keyboard-controls", "source", env=env, cwd=tmp_path)
+    recorder = None
+    try:
+        wait_for_line(player, "Waiting for a subscriber", timeout=180)  # after the build
+        (prefix,) = (tmp_path / "cache" / "bag-types").iterdir()
+        recorder = roc_process("bag", "record", "/vec", "-o", "out", env=environment_with(prefix, env), cwd=tmp_path)
+        wait_subscribed(recorder, ["/vec"])
+        assert "Played 10 messages on 1 topics" in "".join(wait_for_line(player, "Played", timeout=60))
+        assert player.wait(timeout=30) == 0
+        assert f"building bagonly_msgs from the bag's own definitions (not installed here; once, into {prefix})" in (
+            player.stderr.read())
+        interrupt(recorder)
+    finally:
+        for process in (player, recorder):
+            if process is not None:
+                stop_process(process)
+    assert messages(tmp_path / "out") == {"/vec": sent}
+    with Bag(tmp_path / "out") as bag:
+        assert "bagonly_msgs/Vec3 vec" in bag.definitions()[BAG_ONLY_TYPE].text
+    again = subprocess.run([str(BIN / "roc"), "bag", "play", "--disable-keyboard-controls", "source"], env=env,
+                           cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    assert again.returncode == 0 and "Played 10 messages" in again.stdout
+    assert "building" not in again.stderr

@@ -66,7 +66,7 @@ def _raise(type_name: str) -> str:
     raise _NotFound(type_name)
 
 
-def _msg_dependencies(text: str, package: str) -> list[str]:
+def msg_dependencies(text: str, package: str) -> list[str]:
     found = set()
     for match in _MSG_FIELD_TYPE.finditer(text):
         name = match.group(1)
@@ -89,7 +89,7 @@ def _expand(name: str, idl: bool, seen: set[str], depth: int) -> str:
         dependencies = _idl_dependencies(text)
     else:
         text = _file(name, "msg", ".msg")
-        dependencies = _msg_dependencies(text, package)
+        dependencies = msg_dependencies(text, package)
     for dependency in dependencies:
         if (dependency, idl) not in seen:
             seen.add((dependency, idl))  # type: ignore[arg-type]
@@ -125,7 +125,7 @@ def _service_text(service: str) -> str:
     text = _file(service, "srv", ".srv")
     result = f"{DELIMITER}SRV: {service}\n{text}"
     seen: set = set()
-    for dependency in _msg_dependencies(text, service.split("/")[0]):
+    for dependency in msg_dependencies(text, service.split("/")[0]):
         if (dependency, False) not in seen:
             seen.add((dependency, False))
             result += f"\n{DELIMITER}MSG: {dependency}\n" + _expand(dependency, False, seen, MAX_DEPTH)

@@ -92,8 +92,10 @@ def main(argv: list[str] | None = None) -> int:
             from roc.commands.completion import all_options
 
             argv = rewrite_passthrough(argv, all_options(parser))
+        command_words = argv[first_word:]  # the command without roc's global options (-C is already applied)
         args = parser.parse_args(argv)
         args.configuration = config
+        args.command_words = command_words
         module = getattr(args, "_module", None)
         if module is None:
             (getattr(args, "_group", None) or parser).print_help(sys.stderr)

@@ -6,8 +6,9 @@ Pause, play-next and rate changes come from the keyboard (or any caller of ``tog
 ``play_next``, ``change_rate``); ``--clock`` publishes the playback time on /clock.
 
 Types come from the environment: rclpy (Jazzy) can only publish a type whose generated code is
-installed, so a topic whose type is missing is left out with a warning that says so (the bag's own
-definition of it is shown by ``roc bag info --format json``)."""
+installed. The verb builds the types the environment lacks from the bag's own definitions first
+(roc.bag.built_types); a topic whose type is still missing (no ``ros2msg`` definition in the bag) is
+left out with a warning that says so."""
 
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from roc.bag.message import Message
+from roc.bag.metadata import Topic
 from roc.bag.qos import offer_for_recorded
 from roc.bag.reader import Bag
 from roc.bag.selection import Selection
@@ -65,6 +67,15 @@ class PlayResult:
 
 def _absolute(name: str) -> str:
     return name if name.startswith("/") else f"/{name}"
+
+
+def played_topics(bag: Bag, options: PlayOptions) -> list[Topic]:
+    """The bag's topics the options select (/clock of the bag is left out when the player makes one)."""
+    selection = options.selection
+    return [topic for topic in bag.topics()
+            if (selection is None or selection.takes(_absolute(topic.name), topic.type)
+                or selection.takes(topic.name, topic.type))
+            and not (options.clock_hz > 0 and _absolute(topic.name) == CLOCK_TOPIC)]
 
 
 class Player:
@@ -146,22 +157,17 @@ class Player:
 
     # ---- playing --------------------------------------------------------------------------------
     def _publishers(self, graph: Graph, bag: Bag) -> tuple[dict[str, Any], list[str]]:
-        selection, options = self.options.selection, self.options
+        options = self.options
         publishers: dict[str, Any] = {}
         skipped = []
-        for topic in bag.topics():
-            if selection is not None and not selection.takes(_absolute(topic.name), topic.type) and (
-                    not selection.takes(topic.name, topic.type)):
-                continue
-            if options.clock_hz > 0 and _absolute(topic.name) == CLOCK_TOPIC:
-                continue
+        for topic in played_topics(bag, options):
             try:
                 cls = message_class(topic.type)
             except UnknownTypeError:
                 skipped.append(topic.name)
-                self._warn(f"not playing {topic.name}: its type {topic.type} is not installed here, and rclpy "
-                           "can only publish types whose generated code is installed (the bag holds the type's "
-                           "definition: 'roc bag info --format json' shows it); install or source its package")
+                self._warn(f"not playing {topic.name}: its type {topic.type} is not installed here, and the bag "
+                           "holds no message definition of it roc could build (rclpy can only publish types whose "
+                           "generated code is installed); install or source its package")
                 continue
             name = options.remaps.get(topic.name, options.remaps.get(_absolute(topic.name), topic.name))
             override = options.overrides.get(_absolute(topic.name)) or options.overrides.get(topic.name)

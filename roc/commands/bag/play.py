@@ -5,6 +5,7 @@ up and down change the rate."""
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import statistics
 import sys
@@ -111,6 +112,25 @@ def _summary(result) -> list[str]:
     return lines
 
 
+def _start_again_with_missing_types(options, command_words: list[str]) -> None:
+    """Build the types the bag needs and the environment lacks from the bag's own definitions, then
+    replace this process with the same command in an environment that has them (generated libraries
+    load only through the environment a process starts with). Returns when nothing is missing."""
+    from roc.bag.built_types import built_prefix, environment_with
+    from roc.bag.reader import Bag
+    from roc.bag.transport.player import played_topics
+
+    with Bag(options.bag, options.storage) as bag:
+        types = {topic.type for topic in played_topics(bag, options) if not topic.is_service_event}
+        definitions = [d for name, d in bag.definitions().items() if name in types]
+    prefix = built_prefix(definitions, report=lambda line: print_text(f"roc: {line}\n", sys.stderr))
+    if prefix is None:
+        return
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os.execve(sys.executable, [sys.executable, "-m", "roc", *command_words], environment_with(prefix, dict(os.environ)))
+
+
 def run(args: argparse.Namespace) -> int:
     from roc.bag.keyboard import Keyboard
     from roc.bag.qos import load_overrides
@@ -121,15 +141,19 @@ def run(args: argparse.Namespace) -> int:
 
     from roc.bag.transport.player import RATE_STEP, Player, PlayOptions  # joins the ROS graph (rclpy)
 
-    player = Player(PlayOptions(
+    options = PlayOptions(
         bag=args.bag_path, storage=args.storage, rate=args.rate, loop=args.loop, clock_hz=args.clock,
         selection=_selection(args), remaps=_remaps(args.remap), overrides=overrides, start_offset=args.start_offset,
         delay=args.delay, playback_duration=args.playback_duration,
         playback_until=int(args.playback_until_sec * 1e9) if args.playback_until_sec >= 0 else -1,
         read_ahead=args.read_ahead_queue_size, start_paused=args.start_paused,
-        wait_for_all_acked=args.wait_for_all_acked, wait_for_subscribers=args.wait_for_subscribers),
-        report=lambda line: print_text(line + "\n"),
-        warn=lambda line: print_text(f"roc: warning: {line}\n", sys.stderr))
+        wait_for_all_acked=args.wait_for_all_acked, wait_for_subscribers=args.wait_for_subscribers)
+    from roc.bag.built_types import BUILT_PREFIX_VARIABLE
+
+    if not os.environ.get(BUILT_PREFIX_VARIABLE):
+        _start_again_with_missing_types(options, args.command_words)
+    player = Player(options, report=lambda line: print_text(line + "\n"),
+                    warn=lambda line: print_text(f"roc: warning: {line}\n", sys.stderr))
     for number in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
         signal.signal(number, lambda *_: player.stop())
     keys = {"space": player.toggle_pause, "right": player.play_next,
