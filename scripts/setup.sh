@@ -8,9 +8,10 @@
 # .venv/.roc-setup-stamp) it only re-checks the fix-ups and prints one line.
 # Only the dev/CI environment lives here: roc itself never assumes the venv's paths.
 # It changes nothing outside the checkout (and pip's cache) unless asked:
-#   ROC_SETUP_TEST_TOOLS=1  also install zsh, fish and tmux with the system's package manager (apt-get, as
-#                       root), so that the tests of roc's zsh/fish setup scripts and completions and of
-#                       roc tui in a real terminal run instead of skipping; CI sets it (.ci/run). Without
+#   ROC_SETUP_TEST_TOOLS=1  also install zsh, fish, tmux and ccache with the system's package manager
+#                       (apt-get, as root), so that the tests of roc's zsh/fish setup scripts and
+#                       completions, of roc tui in a real terminal and of --compiler-cache ccache run
+#                       instead of skipping; CI sets it (.ci/run). Without
 #                       it, missing tools are only reported. roc itself needs none of them.
 # Environment: PYTHON (interpreter that creates the venv, default python3),
 #              ROC_SETUP_FORCE=1 (redo the pip steps even if the stamp matches),
@@ -60,11 +61,11 @@ EOF
 }
 
 # ---- test-time tools (opt-in: their tests skip without them): the shells the tests source roc's
-# setup scripts in, and tmux, which runs roc tui in a real terminal. Installed only with
+# setup scripts in, tmux, which runs roc tui in a real terminal, and ccache (a compiler cache). Installed only with
 # ROC_SETUP_TEST_TOOLS=1; otherwise a full set-up says which are missing.
 setup_test_tools() {
     local missing=() tool
-    for tool in zsh fish tmux; do
+    for tool in zsh fish tmux ccache; do
         command -v "$tool" >/dev/null 2>&1 || missing+=("$tool")
     done
     [ "${#missing[@]}" -gt 0 ] || return 0

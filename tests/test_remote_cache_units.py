@@ -6,7 +6,6 @@ from __future__ import annotations
 import io
 import json
 import os
-import sys
 import tarfile
 from pathlib import Path
 
@@ -207,6 +206,7 @@ def test_compiler_cache_settings(tmp_path, monkeypatch) -> None:
     assert ccache and ccache.cmake_arguments() == [f"-DCMAKE_C_COMPILER_LAUNCHER={tools}/ccache",
                                                    f"-DCMAKE_CXX_COMPILER_LAUNCHER={tools}/ccache"]
     assert ccache.environment == {"CCACHE_BASEDIR": str(root), "CCACHE_DIR": str(Path("cache-dir").absolute()),
+                                  "CCACHE_STATSLOG": str(root / "build" / "ccache-stats.log"),
                                   "CCACHE_REMOTE_STORAGE": "https://cache.example/team/ccache|read-only"}
     sccache = compiler_cache("sccache", None, root, root / "build", read)
     assert sccache and sccache.environment["SCCACHE_WEBDAV_ENDPOINT"] == "https://cache.example/team"
@@ -256,7 +256,8 @@ def test_bad_settings_are_usage_errors_before_anything_is_written(tmp_path, argu
 
     (tmp_path / "src" / "pkg").mkdir(parents=True)
     (tmp_path / "src" / "pkg" / "CMakeLists.txt").write_text("cmake_minimum_required(VERSION 3.14)\nproject(pkg)\n")
-    env = ros_env(PATH=f"{Path(sys.executable).parent}:/usr/bin:/bin")
+    (tmp_path / "empty").mkdir()
+    env = ros_env(PATH=str(tmp_path / "empty"))  # no ccache; refused before anything runs
     result = roc("work", "build", *arguments, cwd=tmp_path, env=env)
     assert result.returncode == 2 and result.stderr.startswith("roc: error: ") and message in result.stderr
     assert "secret" not in result.stderr and "Traceback" not in result.stderr

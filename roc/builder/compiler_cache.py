@@ -11,7 +11,8 @@ roc passes none, so none lands in a build's saved environment.
 
 sccache runs as a server that keeps the settings it started with, so each build starts its own, on a
 socket of its own (SCCACHE_SERVER_UDS, named after the build base), and stops it at the end, after
-reading its statistics: the hit rate roc prints is this build's.
+reading its statistics; ccache writes each build's to a stats log of its own (CCACHE_STATSLOG in the
+build base): either way, the hit rate roc prints is this build's.
 
 The launcher is not part of any fingerprint: a cached compile gives the same output.
 """
@@ -43,10 +44,10 @@ class CompilerCache:
         return [f"-DCMAKE_{language}_COMPILER_LAUNCHER={self.program}" for language in ("C", "CXX")]
 
     def finish(self) -> str | None:
-        """sccache: stop this build's server; its compile statistics as one line (None for ccache, or
-        when the server never started)."""
-        if "SCCACHE_SERVER_UDS" not in self.environment:
-            return None
+        """This build's compile statistics as one line (None when nothing was compiled); sccache: stop
+        this build's server first."""
+        if "CCACHE_STATSLOG" in self.environment:
+            return self._ccache_statistics()
         env = {**os.environ, **self.environment}
         if not _listening(self.environment["SCCACHE_SERVER_UDS"]):
             return None  # nothing was compiled (asking for statistics would start a server)
@@ -59,9 +60,25 @@ class CompilerCache:
             misses = sum(stats["cache_misses"]["counts"].values())
         except (ValueError, KeyError, TypeError, AttributeError):
             return None
-        if not hits + misses:
+        return _summary("sccache", hits, misses)
+
+    def _ccache_statistics(self) -> str | None:
+        """From this build's stats log (ccache's own statistics are the cache's, over every build): a
+        ``# source`` line per compile, then one line per counter it updated."""
+        log = Path(self.environment["CCACHE_STATSLOG"])
+        try:
+            counters = log.read_text(errors="replace").split()
+        except OSError:
             return None
-        return f"sccache: {hits} of {hits + misses} compiles from the cache ({100 * hits / (hits + misses):.0f} %)"
+        log.unlink(missing_ok=True)
+        hits = counters.count("direct_cache_hit") + counters.count("preprocessed_cache_hit")
+        return _summary("ccache", hits, counters.count("cache_miss"))
+
+
+def _summary(tool: str, hits: int, misses: int) -> str | None:
+    if not hits + misses:
+        return None
+    return f"{tool}: {hits} of {hits + misses} compiles from the cache ({100 * hits / (hits + misses):.0f} %)"
 
 
 def _listening(path: str) -> bool:
@@ -92,7 +109,9 @@ def compiler_cache(tool: str | None, directory: str | None, root: Path, build_ba
     if program is None:
         raise UsageError(f"--compiler-cache {tool}: '{tool}' is not on PATH; install it ({INSTALL_HINTS[tool]})")
     if tool == "ccache":
-        environment = {"CCACHE_BASEDIR": str(root)}
+        statistics = build_base.absolute() / "ccache-stats.log"  # this build's compiles only
+        statistics.unlink(missing_ok=True)
+        environment = {"CCACHE_BASEDIR": str(root), "CCACHE_STATSLOG": str(statistics)}
     else:
         name = hashlib.sha256(str(build_base).encode()).hexdigest()[:16]  # a socket path must stay short
         environment = {"SCCACHE_BASEDIRS": str(root),
