@@ -24,10 +24,13 @@ import argparse
 import os
 import re
 from pathlib import Path
-from typing import Any
 
 from roc.errors import UsageError
 from roc.messages import did_you_mean, unknown_package
+
+TYPE_CHECKING = False  # typing is not imported at run time (start-up time of every verb)
+if TYPE_CHECKING:
+    from typing import Any
 
 VERBS = ("list", "info", "graph", "build", "test", "env", "cache", "create")
 PACKAGE_KEYS = {"cmake-args": list, "ament-cmake-args": list, "skip": bool}

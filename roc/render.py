@@ -6,11 +6,13 @@ Verbs build plain data (lists, dicts) and pick a renderer by ``--format``; nothi
 
 from __future__ import annotations
 
-import json
 import sys
 from collections.abc import Callable, Iterable, Sequence
 from functools import lru_cache
-from typing import Any, TextIO
+
+TYPE_CHECKING = False  # typing and json are not imported by a command that does not need them (start-up time)
+if TYPE_CHECKING:
+    from typing import Any, TextIO
 
 
 def print_lines(lines: Iterable[str], stream: TextIO | None = None) -> None:
@@ -32,6 +34,8 @@ def print_events(events: Iterable[dict[str, Any]], fmt: str, text: Callable[[dic
 
 def print_json(data: Any, stream: TextIO | None = None) -> None:
     """One JSON document, indented (for listings)."""
+    import json
+
     out = stream or sys.stdout
     json.dump(data, out, indent=2, sort_keys=False)
     out.write("\n")
@@ -39,6 +43,8 @@ def print_json(data: Any, stream: TextIO | None = None) -> None:
 
 def json_line(data: Any) -> str:
     """One compact JSON object and a newline."""
+    import json
+
     return json.dumps(data, separators=(",", ":")) + "\n"
 
 

@@ -105,3 +105,23 @@ def test_warnings_are_repeated_from_the_cache(ws):
     for _ in range(2):
         result = subprocess.run([str(BIN / "roc"), "work", "list"], cwd=ws, capture_output=True, text=True)
         assert "has build type ament_python but no setup.py" in result.stderr
+
+
+def test_inputs_below_the_root_are_relative_and_others_absolute_and_both_are_checked(ws):
+    """The cache checks its inputs from the root's directory (relative paths stat faster); a base path
+    outside the root stays absolute, and an edit on either side is seen."""
+    import marshal
+
+    outside = ws.parent / "elsewhere"
+    (outside / "c").mkdir(parents=True)
+    (outside / "c" / "package.xml").write_text(_manifest("c"))
+    assert sorted(_list(ws, "--base-paths", "src", str(outside))) == ["a", "b", "c"]
+    (cache,) = (ws.parent / "cache").glob("discovery-*.marshal")
+    inputs = marshal.loads(cache.read_bytes())["inputs"]
+    assert "src/a/package.xml" in inputs and str(outside / "c" / "package.xml") in inputs
+    (outside / "c" / "package.xml").write_text(_manifest("c0"))
+    _touch_later(outside / "c" / "package.xml")
+    assert sorted(_list(ws, "--base-paths", "src", str(outside))) == ["a", "b", "c0"]
+    (ws / "src" / "a" / "package.xml").write_text(_manifest("a", "<depend>c0</depend>"))
+    _touch_later(ws / "src" / "a" / "package.xml")
+    assert _list(ws, "--base-paths", "src", str(outside)) == ["c0", "a", "b"]

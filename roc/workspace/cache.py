@@ -12,7 +12,6 @@ versions); a file that does not load is ignored, as a damaged one.
 
 from __future__ import annotations
 
-import json
 import marshal
 import os
 import sys
@@ -35,7 +34,7 @@ def cache_directory() -> Path:
 
 
 def _cache_key(root: Path, base_paths, paths) -> str:
-    return json.dumps([__version__, list(sys.version_info[:2]), str(root), base_paths, paths])
+    return repr([__version__, list(sys.version_info[:2]), str(root), base_paths, paths])  # json costs an import
 
 
 def _cache_path(key: str) -> Path:
@@ -78,15 +77,31 @@ def _inputs(root: Path, visited: list[str], packages: list[Package]) -> dict[str
     return inputs
 
 
-def _unchanged(path: str, stamp: list[int] | None) -> bool:
-    """As ``_stamp(path) == stamp``, without making a list (this runs for every input of the cache)."""
+def _relative(root: Path, inputs: dict[str, list[int] | None]) -> dict[str, list[int] | None]:
+    """The inputs' paths relative to ``root`` where they are below it: checked from ``root``'s file
+    descriptor, the kernel resolves a few path components per stat instead of every one."""
+    prefix = str(root).rstrip(os.sep) + os.sep
+    return {path[len(prefix):] if path.startswith(prefix) else path: stamp for path, stamp in inputs.items()}
+
+
+def _all_unchanged(root: Path, inputs: dict[str, list[int] | None]) -> bool:
+    """As ``_stamp(path) == stamp`` for each input (an ignore marker, ``[1]``, need only be there):
+    this is most of the time of a command on a large workspace, so it stats as little as it can."""
+    stat = os.stat
+    directory = os.open(root, os.O_RDONLY | os.O_DIRECTORY)
     try:
-        info = os.stat(path)
-    except OSError:
-        return stamp is None
-    if stamp == [1]:  # an ignore marker: it must still be there
+        for path, stamp in inputs.items():
+            try:
+                info = stat(path, dir_fd=directory)  # an absolute path ignores dir_fd
+            except OSError:
+                if stamp is None:
+                    continue
+                return False
+            if stamp is None or (stamp != [1] and (info.st_mtime_ns != stamp[0] or info.st_size != stamp[1])):
+                return False
         return True
-    return stamp is not None and info.st_mtime_ns == stamp[0] and info.st_size == stamp[1]
+    finally:
+        os.close(directory)
 
 
 def _compact(package: dict) -> dict:
@@ -109,7 +124,7 @@ def cached_discovery(
     path = _cache_path(key)
     try:
         data = marshal.loads(path.read_bytes())
-        if data["key"] == key and all(_unchanged(p, stamp) for p, stamp in data["inputs"].items()):
+        if data["key"] == key and _all_unchanged(root, data["inputs"]):
             if all(variables.get(name) == value for name, value in data["conditions"].items()):
                 packages = [Package.from_dict(item) for item in data["packages"]]
                 for warning in data["warnings"]:
@@ -122,7 +137,7 @@ def cached_discovery(
     packages = discover(visited)
     data = {
         "key": key,
-        "inputs": _inputs(root, visited, packages),
+        "inputs": _relative(root, _inputs(root, visited, packages)),
         "conditions": {name: variables.get(name) for name in _condition_variables(packages)},
         "warnings": messages.emitted[first_warning:],
         "packages": [_compact(p.to_dict()) for p in packages],

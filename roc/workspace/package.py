@@ -7,8 +7,8 @@ from the discovery cache.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
 
+TYPE_CHECKING = False  # typing is not imported at run time (start-up time of every verb)
 if TYPE_CHECKING:
     from roc.workspace.manifest import Manifest
 
