@@ -26,54 +26,37 @@ def _checkout(base, name):
     return ws
 
 
-def _compiles(result, tool: str = "sccache") -> tuple[int, int]:
+def _compiles(result, tool: str) -> tuple[int, int]:
     """(from the cache, all) from roc's line of the compiler cache's statistics."""
     line = next(line for line in result.stdout.splitlines() if line.startswith(f"{tool}: "))
     words = line.split()
     return int(words[1]), int(words[3])
 
 
-def test_second_checkout_compiles_from_the_local_compiler_cache(tmp_path):
+@pytest.mark.parametrize("tool", ["sccache", pytest.param("ccache", marks=pytest.mark.skipif(
+    shutil.which("ccache") is None,
+    reason="ccache is not installed (ROC_SETUP_TEST_TOOLS=1 bash scripts/setup.sh installs it)"))])
+def test_second_checkout_compiles_from_the_local_compiler_cache(tmp_path, tool):
     env = ros_env()
-    directory = str(tmp_path / "sccache")
+    options = ("--compiler-cache", tool, "--compiler-cache-dir", str(tmp_path / tool))
     first = _checkout(tmp_path, "first")
-    built = roc("work", "build", "--compiler-cache", "sccache", "--compiler-cache-dir", directory, cwd=first, env=env)
+    built = roc("work", "build", *options, cwd=first, env=env)
     assert built.returncode == 0, built.stdout + built.stderr
     assert "CMAKE_CXX_COMPILER_LAUNCHER:" in (first / "build" / "core" / "CMakeCache.txt").read_text()
-    assert _compiles(built) == (0, COMPILED)
+    assert _compiles(built, tool) == (0, COMPILED)
     assert not list((tmp_path).glob("roc-sccache-*")), "the server's socket is left"
     second = _checkout(tmp_path / "elsewhere", "second")
-    built = roc("work", "build", "--compiler-cache", "sccache", "--compiler-cache-dir", directory, cwd=second, env=env)
+    built = roc("work", "build", *options, cwd=second, env=env)
     assert built.returncode == 0, built.stdout + built.stderr
-    assert _compiles(built) == (COMPILED, COMPILED)
+    assert _compiles(built, tool) == (COMPILED, COMPILED)  # the base directory makes the paths agree
     ran = in_sourced_shell(second, "install/app/lib/app/app; plain")
     assert ran.returncode == 0 and "core says 42" in ran.stdout
-    noop = roc("work", "build", "--compiler-cache", "sccache", "--compiler-cache-dir", directory, cwd=second, env=env)
-    assert noop.returncode == 0 and "sccache" not in noop.stdout  # nothing compiled: no server, no line
+    noop = roc("work", "build", *options, cwd=second, env=env)
+    assert noop.returncode == 0 and tool not in noop.stdout  # nothing compiled: no line (and no sccache server)
     # switched off: configured afresh, without the launcher
     off = roc("work", "build", "--force", cwd=second, env=env)
     assert off.returncode == 0
     assert "COMPILER_LAUNCHER:" not in (second / "build" / "core" / "CMakeCache.txt").read_text()
-
-
-@pytest.mark.skipif(shutil.which("ccache") is None,
-                    reason="ccache is not installed (ROC_SETUP_TEST_TOOLS=1 bash scripts/setup.sh installs it)")
-def test_second_checkout_compiles_from_ccache(tmp_path):
-    env = ros_env()
-    directory = str(tmp_path / "ccache")
-    first = _checkout(tmp_path, "first")
-    built = roc("work", "build", "--compiler-cache", "ccache", "--compiler-cache-dir", directory, cwd=first, env=env)
-    assert built.returncode == 0, built.stdout + built.stderr
-    assert "CMAKE_C_COMPILER_LAUNCHER:" in (first / "build" / "plain" / "CMakeCache.txt").read_text()
-    assert _compiles(built, "ccache") == (0, COMPILED)
-    second = _checkout(tmp_path / "elsewhere", "second")
-    built = roc("work", "build", "--compiler-cache", "ccache", "--compiler-cache-dir", directory, cwd=second, env=env)
-    assert built.returncode == 0, built.stdout + built.stderr
-    assert _compiles(built, "ccache") == (COMPILED, COMPILED)  # the base directory makes the paths agree
-    ran = in_sourced_shell(second, "install/app/lib/app/app; plain")
-    assert ran.returncode == 0 and "core says 42" in ran.stdout
-    noop = roc("work", "build", "--compiler-cache", "ccache", "--compiler-cache-dir", directory, cwd=second, env=env)
-    assert noop.returncode == 0 and "ccache" not in noop.stdout  # nothing compiled: no line
 
 
 def test_compiler_cache_shares_the_remote_cache_server(tmp_path):
@@ -87,7 +70,7 @@ def test_compiler_cache_shares_the_remote_cache_server(tmp_path):
                     "read-write", "--compiler-cache-dir", str(tmp_path / "ci-cache"), cwd=ci, env=env)
         assert built.returncode == 0, built.stdout + built.stderr
         assert any((root / "team" / "sccache").rglob("*")), "sccache wrote nothing to the WebDAV server"
-        assert _compiles(built) == (0, COMPILED)
+        assert _compiles(built, "sccache") == (0, COMPILED)
         dev = _checkout(tmp_path / "elsewhere", "dev")
         # changed build files, same compiles: every remote key misses, every compile hits
         manifest = dev / "src" / "core" / "package.xml"
@@ -98,4 +81,4 @@ def test_compiler_cache_shares_the_remote_cache_server(tmp_path):
                     str(tmp_path / "dev-cache"), cwd=dev, env=env)
         assert built.returncode == 0, built.stdout + built.stderr
         assert "Restored" not in built.stdout
-        assert _compiles(built) == (COMPILED, COMPILED)
+        assert _compiles(built, "sccache") == (COMPILED, COMPILED)
