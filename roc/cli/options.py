@@ -125,6 +125,21 @@ def values_source(args: argparse.Namespace, positional: str) -> tuple[str | None
     return getattr(args, positional), positional
 
 
+DEFAULT_TRUNCATE_LENGTH = 128  # ros2's: arrays, bytes and strings are cut after this many elements
+
+
+def add_message_display_arguments(parser: argparse.ArgumentParser) -> None:
+    """How ``echo`` verbs print a message's fields, with ros2's options."""
+    parser.add_argument("--full-length", "-f", action="store_true",
+                        help="do not truncate arrays, bytes and strings")
+    parser.add_argument("--truncate-length", "-l", type=int, default=DEFAULT_TRUNCATE_LENGTH, metavar="N",
+                        help="truncate arrays, bytes and strings after N elements "
+                             f"(default: {DEFAULT_TRUNCATE_LENGTH})")
+    parser.add_argument("--no-arr", action="store_true", help="do not print array fields")
+    parser.add_argument("--no-str", action="store_true", help="do not print string fields")
+    parser.add_argument("--flow-style", action="store_true", help="print lists inline (not with --csv)")
+
+
 def add_graph_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of every verb that queries the ROS graph."""
     add_format_argument(parser)

@@ -5,9 +5,8 @@ from __future__ import annotations
 
 import argparse
 
-from roc.cli.options import add_graph_arguments
+from roc.cli.options import add_graph_arguments, add_message_display_arguments
 from roc.commands.graph_query import publisher_wait, snapshot
-from roc.commands.topic.echo import DEFAULT_TRUNCATE_LENGTH
 from roc.errors import RocError
 from roc.render import print_json_line, print_text
 from roc.ros.client import stream
@@ -23,14 +22,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("service_type", nargs="?", help="type of the service, e.g. std_srvs/srv/SetBool "
                                                         "(default: the type the graph gives the service)")
     parser.add_argument("--csv", action="store_true", help="print all fields, recursively, separated by commas")
-    parser.add_argument("--full-length", "-f", action="store_true",
-                        help="do not truncate arrays, bytes and strings")
-    parser.add_argument("--truncate-length", "-l", type=int, default=DEFAULT_TRUNCATE_LENGTH, metavar="N",
-                        help="truncate arrays, bytes and strings after N elements "
-                             f"(default: {DEFAULT_TRUNCATE_LENGTH})")
-    parser.add_argument("--no-arr", action="store_true", help="do not print array fields")
-    parser.add_argument("--no-str", action="store_true", help="do not print string fields")
-    parser.add_argument("--flow-style", action="store_true", help="print lists inline (not with --csv)")
+    add_message_display_arguments(parser)
     add_graph_arguments(parser)
 
 

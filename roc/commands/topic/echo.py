@@ -6,7 +6,12 @@ import argparse
 import base64
 import sys
 
-from roc.cli.options import add_graph_arguments, add_qos_arguments, qos_options
+from roc.cli.options import (
+    add_graph_arguments,
+    add_message_display_arguments,
+    add_qos_arguments,
+    qos_options,
+)
 from roc.commands.graph_query import publisher_wait
 from roc.errors import RocError, UsageError
 from roc.render import json_line, print_text
@@ -14,7 +19,6 @@ from roc.ros.client import stream
 from roc.ros.messages import echo_text, field_names, get_field, value_to_data
 from roc.ros.types import message_class
 
-DEFAULT_TRUNCATE_LENGTH = 128
 INFO_FIELDS = ("source_timestamp", "received_timestamp", "publication_sequence_number", "reception_sequence_number")
 
 
@@ -25,14 +29,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_qos_arguments(parser, "sensor_data", "subscribe")
     parser.add_argument("--csv", action="store_true", help="print all fields, recursively, separated by commas")
     parser.add_argument("--field", help="print one field, sub-fields separated by '.', e.g. pose.pose.position")
-    parser.add_argument("--full-length", "-f", action="store_true",
-                        help="do not truncate arrays, bytes and strings")
-    parser.add_argument("--truncate-length", "-l", type=int, default=DEFAULT_TRUNCATE_LENGTH, metavar="N",
-                        help="truncate arrays, bytes and strings after N elements "
-                             f"(default: {DEFAULT_TRUNCATE_LENGTH})")
-    parser.add_argument("--no-arr", action="store_true", help="do not print array fields")
-    parser.add_argument("--no-str", action="store_true", help="do not print string fields")
-    parser.add_argument("--flow-style", action="store_true", help="print lists inline (not with --csv)")
+    add_message_display_arguments(parser)
     parser.add_argument("--no-lost-messages", action="store_true", help="do not report lost messages")
     parser.add_argument("--raw", action="store_true", help="print the serialised (CDR) bytes")
     parser.add_argument("--filter", dest="filter_expr", metavar="EXPR",
