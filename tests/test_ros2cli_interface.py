@@ -14,8 +14,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from build_helpers import BIN
-from graph_helpers import ORACLE_VENV
+from graph_helpers import ORACLE_VENV, graph_env, stop_daemon
 from ros2cli_harness import TOOLS, Cli, expect_lines, oracle, output_filter
 
 pytestmark = pytest.mark.slow
@@ -31,10 +30,12 @@ NESTED = "ros2cli_test_interfaces/{kind}/ShortVariedMultiNested"
 
 
 @pytest.fixture(scope="module", params=TOOLS)
-def cli(request, oracle) -> Cli:  # noqa: F811
-    env = dict(os.environ, AMENT_PREFIX_PATH=os.pathsep.join([str(TEST_INTERFACES), str(ORACLE_VENV), sys.prefix]),
-               PATH=f"{BIN}{os.pathsep}{os.environ.get('PATH', '/usr/bin:/bin')}", PYTHONUNBUFFERED="1")
-    return Cli(request.param, env)
+def cli(request, oracle, tmp_path_factory):  # noqa: F811
+    # a domain and a daemon directory of its own: a verb that asks the graph starts a daemon, stopped here
+    env = graph_env(17, tmp_path_factory.mktemp("runtime"), PYTHONUNBUFFERED="1",
+                    AMENT_PREFIX_PATH=os.pathsep.join([str(TEST_INTERFACES), str(ORACLE_VENV), sys.prefix]))
+    yield Cli(request.param, env)
+    stop_daemon(env)
 
 
 def test_list_interfaces(cli):
