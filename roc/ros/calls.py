@@ -34,11 +34,11 @@ def _received(params: dict[str, Any], key: str, cls: Any) -> Any:
     return deserialize_message(base64.b64decode(params[key]), cls)
 
 
-def _answer(params: dict[str, Any], message: Any) -> dict[str, Any]:
+def _answer(message: Any, plain: bool) -> dict[str, Any]:
     """A response, feedback or result: base64 CDR (``data``), and as plain data (``value``) for a
-    client that sent plain data."""
+    client that sent plain data (``plain``)."""
     answer = {"data": base64.b64encode(serialize(message)).decode()}
-    if any(key.endswith("_data") for key in params):
+    if plain:
         answer["value"] = value_to_data(message)
     return answer
 
@@ -48,7 +48,7 @@ def call(graph, params: dict[str, Any]) -> Events:
     plain data): ``waiting`` while no server is available, then ``request`` and ``response {data,
     value?}`` per call; with ``rate`` (Hz) again and again until closed."""
     cls = service_class(params["type"])
-    request = _received(params, "request", cls.Request)
+    request, plain = _received(params, "request", cls.Request), "request_data" in params
     client = graph.node.create_client(cls, params["service"])
     try:
         if not client.wait_for_service(timeout_sec=0.1):
@@ -59,7 +59,7 @@ def call(graph, params: dict[str, Any]) -> Events:
             yield {"event": "request"}
             future = client.call_async(request)
             yield from _wait(partial(_done, future))
-            yield {"event": "response", **_answer(params, future.result())}
+            yield {"event": "response", **_answer(future.result(), plain)}
             if period is None:
                 return
             due += period
@@ -83,7 +83,7 @@ def goal(graph, params: dict[str, Any]) -> Events:
     from rclpy.action import ActionClient
 
     cls = action_class(params["type"])
-    request = _received(params, "goal", cls.Goal)
+    request, plain = _received(params, "goal", cls.Goal), "goal_data" in params
     client = ActionClient(graph.node, cls, params["action"])
     handle = None
     try:
@@ -104,14 +104,14 @@ def goal(graph, params: dict[str, Any]) -> Events:
             finished = _done(result)
             while not feedback.empty():
                 message = feedback.get().feedback
-                yield {"event": "feedback", **_answer(params, message)}
+                yield {"event": "feedback", **_answer(message, plain)}
             if finished:
                 break
             yield {"event": "heartbeat"}
         outcome = result.result()
         handle = None
         status = GOAL_STATUS.get(outcome.status, "UNKNOWN")
-        yield {"event": "result", **_answer(params, outcome.result), "status": status}
+        yield {"event": "result", **_answer(outcome.result, plain), "status": status}
     finally:
         if handle is not None:  # the client went away first: do not leave the goal running
             canceled = threading.Event()

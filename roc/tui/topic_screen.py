@@ -16,12 +16,11 @@ from textual.screen import Screen
 from textual.widgets import Footer, Static
 from textual.worker import get_current_worker
 
+from roc.cli.options import DEFAULT_TRUNCATE_LENGTH
 from roc.errors import RocError
 from roc.ros.rates import Sample, Window
 from roc.tui.model import TOPIC_WINDOW, Row, bandwidth_text, diagnoses, endpoint_cells, rate_text, shown_endpoints
 from roc.tui.widgets import ListTable, Prompt, host
-
-TRUNCATE_LENGTH = 128  # arrays and strings shown in the echo pane are cut after this many elements
 
 ECHO_SECONDS = 0.25  # the echo pane shows the latest message at most this often
 
@@ -109,7 +108,7 @@ class TopicScreen(Screen):
         worker = get_current_worker()
         try:
             # the daemon decodes the last message of each batch (``value``): no rclpy in this process
-            params = {"topic": self.topic, "wait": 0, "latest_value": True, "truncate_length": TRUNCATE_LENGTH}
+            params = {"topic": self.topic, "wait": 0, "latest_value": True, "truncate_length": DEFAULT_TRUNCATE_LENGTH}
             for event in host(self).feed.stream("echo", params, lambda: worker.is_cancelled):
                 if event["event"] == "subscribed":
                     self.type_name = event["type"]
