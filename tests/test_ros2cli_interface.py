@@ -32,7 +32,7 @@ NESTED = "ros2cli_test_interfaces/{kind}/ShortVariedMultiNested"
 @pytest.fixture(scope="module", params=TOOLS)
 def cli(request, oracle, tmp_path_factory):  # noqa: F811
     # a domain and a daemon directory of its own: a verb that asks the graph starts a daemon, stopped here
-    env = graph_env(17, tmp_path_factory.mktemp("runtime"), PYTHONUNBUFFERED="1",
+    env = graph_env(40, tmp_path_factory.mktemp("runtime"), PYTHONUNBUFFERED="1",
                     AMENT_PREFIX_PATH=os.pathsep.join([str(TEST_INTERFACES), str(ORACLE_VENV), sys.prefix]))
     yield Cli(request.param, env)
     stop_daemon(env)
