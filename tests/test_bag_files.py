@@ -15,6 +15,7 @@ import pytest
 import yaml
 from bag_helpers import TEST_MSGS, filled, load
 from build_helpers import BIN
+from graph_helpers import graph_env, stop_daemon
 from oracles import SHARED, require_oracle
 
 from roc.bag.definitions import definition
@@ -456,7 +457,12 @@ def test_interface_show_of_a_type_only_a_bag_knows(tmp_path: Path) -> None:
     part = roc("interface", "show", "robot_msgs/msg/Part", "--bag", str(tmp_path / "bag"), "--format", "json")
     assert json.loads(part.stdout) | {"bag": None} == {"type": "robot_msgs/msg/Part", "file": None, "bag": None,
                                                        "text": "int32 count # how many"}
-    assert roc("interface", "show", "robot_msgs/msg/Thing").returncode == 1  # not installed here
+    # not installed here, nor known to the graph (a domain and daemon of its own, the daemon stopped after)
+    env = graph_env(41, tmp_path / "runtime")
+    try:
+        assert roc("interface", "show", "robot_msgs/msg/Thing", env=env).returncode == 1
+    finally:
+        stop_daemon(env)
     missing = roc("interface", "show", "robot_msgs/msg/Other", "--bag", str(tmp_path / "bag"))
     assert (missing.returncode, missing.stdout) == (1, "")
     assert missing.stderr == (f"roc: error: {tmp_path / 'bag'}: the bag holds no definition of robot_msgs/msg/Other "
