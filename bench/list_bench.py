@@ -8,7 +8,8 @@ and for two environments, both tools run from the workspace root as separate pro
 ``time.perf_counter`` around ``subprocess.run``:
 
 * ``plain``: neither ``_ROS_WHEELS_BOOTSTRAP_COMPLETE`` nor the wheels' ``LD_LIBRARY_PATH`` is set, so
-  each Python start re-executes itself once through the ros-wheels-bootstrapper ``.pth``;
+  colcon's Python re-executes itself once through the ros-wheels-bootstrapper ``.pth`` (roc's command,
+  bin/roc, sets what the bootstrapper would and starts Python once);
 * ``boot``: both are set, as in an activated ROS environment, so no process re-executes.
 
 Runs of the two tools are interleaved (after the warm-up runs) so that drift of the machine hits both
