@@ -125,3 +125,16 @@ def test_inputs_below_the_root_are_relative_and_others_absolute_and_both_are_che
     (ws / "src" / "a" / "package.xml").write_text(_manifest("a", "<depend>c0</depend>"))
     _touch_later(ws / "src" / "a" / "package.xml")
     assert _list(ws, "--base-paths", "src", str(outside)) == ["c0", "a", "b"]
+
+
+def test_the_cached_order_is_colcons_also_when_packages_are_ignored_or_form_a_cycle(ws):
+    (ws / "src" / "c").mkdir()
+    (ws / "src" / "c" / "package.xml").write_text(_manifest("c"))
+    for _ in range(2):  # the first run fills the cache, the second reads it
+        assert _list(ws) == ["a", "c", "b"]  # layers: a c, then b
+        assert _list(ws, "--packages-ignore", "a") == ["b", "c"]  # without a, b is in the first layer
+    _touch_later(ws / "src" / "a" / "package.xml")
+    (ws / "src" / "a" / "package.xml").write_text(_manifest("a", "<depend>b</depend>"))
+    for _ in range(2):
+        result = subprocess.run([str(BIN / "roc"), "work", "list", "-t"], cwd=ws, capture_output=True, text=True)
+        assert result.returncode != 0 and "dependency cycle" in result.stderr, result.stderr

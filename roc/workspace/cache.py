@@ -21,6 +21,7 @@ from pathlib import Path
 
 from roc import __version__, messages
 from roc.fsutil import write_bytes_atomic
+from roc.workspace.dependencies import DependencyCycleError, topological_order
 from roc.workspace.package import IGNORE_MARKERS, Package
 
 IDENTIFICATION_FILES = ("package.xml", "setup.py", "setup.cfg", "colcon.pkg", "CMakeLists.txt", "manifest.xml")
@@ -118,8 +119,10 @@ def _condition_variables(packages: list[Package]) -> list[str]:
 def cached_discovery(
     root: Path, variables: Mapping[str, str], base_paths, paths,
     discover: Callable[[list[str]], list[Package]],
-) -> list[Package]:
-    """The packages ``discover(visited)`` finds, from the cache when nothing they came from changed."""
+) -> tuple[list[Package], bool]:
+    """The packages ``discover(visited)`` finds, from the cache when nothing they came from changed, and
+    whether they are in topological order: the cache keeps them so unless they form a cycle (ordering
+    1000 packages took a tenth of a cached ``roc work list -t``)."""
     key = _cache_key(root, base_paths, paths)
     path = _cache_path(key)
     try:
@@ -129,21 +132,26 @@ def cached_discovery(
                 packages = [Package.from_dict(item) for item in data["packages"]]
                 for warning in data["warnings"]:
                     messages.warn(warning)
-                return packages
+                return packages, data["ordered"]
     except (OSError, ValueError, EOFError, KeyError, TypeError):
         pass  # no cache yet, or one from another roc version: discover
     first_warning = len(messages.emitted)
     visited: list[str] = []
     packages = discover(visited)
+    try:
+        packages, ordered = topological_order(packages), True
+    except DependencyCycleError:
+        ordered = False
     data = {
         "key": key,
         "inputs": _relative(root, _inputs(root, visited, packages)),
         "conditions": {name: variables.get(name) for name in _condition_variables(packages)},
         "warnings": messages.emitted[first_warning:],
         "packages": [_compact(p.to_dict()) for p in packages],
+        "ordered": ordered,
     }
     try:
         write_bytes_atomic(path, marshal.dumps(data))
     except OSError:
         pass  # a read-only home: work without the cache
-    return packages
+    return packages, ordered

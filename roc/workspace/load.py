@@ -57,6 +57,11 @@ def find_workspace_root_for(args: argparse.Namespace) -> Path:
 def discover_workspace(root: Path, base_paths: list[str] | None = None,
                        paths: list[str] | None = None) -> list[Package]:
     """The packages of the workspace at ``root`` (from the discovery cache when nothing changed)."""
+    return _discover(root, base_paths, paths)[0]
+
+
+def _discover(root: Path, base_paths: list[str] | None, paths: list[str] | None) -> tuple[list[Package], bool]:
+    """``discover_workspace``'s packages, and whether they are in topological order already."""
     variables = condition_environment(os.environ)
 
     def discover(visited: list[str]) -> list[Package]:
@@ -69,7 +74,7 @@ def discover_workspace(root: Path, base_paths: list[str] | None = None,
 
 def load_workspace(args: argparse.Namespace) -> Workspace:
     root = resolve_root(args)
-    packages = discover_workspace(root, args.base_paths, args.paths)
+    packages, in_order = _discover(root, args.base_paths, args.paths)
     names = {p.name for p in packages}
     config = getattr(args, "configuration", None)
     if config is not None:
@@ -77,7 +82,9 @@ def load_workspace(args: argparse.Namespace) -> Workspace:
 
         check_package_tables(config, names)
     check_selection_arguments(args, names)
-    ordered = topological_order(ignore_packages(args, packages))
+    kept = ignore_packages(args, packages)
+    # with packages left out, colcon's layers of the others can differ: order them again
+    ordered = kept if in_order and len(kept) == len(packages) else topological_order(kept)
     build_base = root / getattr(args, "build_base", "build")
     index = DependencyIndex(ordered)
     return Workspace(root, ordered, select_packages(args, ordered, build_base, index), index)

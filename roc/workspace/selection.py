@@ -57,6 +57,8 @@ def check_selection_arguments(args: argparse.Namespace, names: set[str]) -> None
 def ignore_packages(args: argparse.Namespace, packages: list[Package]) -> list[Package]:
     ignored = set(getattr(args, "packages_ignore", None) or [])
     patterns = getattr(args, "packages_ignore_regex", None)
+    if not ignored and not patterns:
+        return packages
     return [p for p in packages if p.name not in ignored and not _matches(patterns, p.name)]
 
 
@@ -107,8 +109,9 @@ def select_packages(args: argparse.Namespace, ordered: list[Package], build_base
     if args.packages_select is not None or args.packages_select_regex is not None:
         chosen = set(args.packages_select or [])
         selected &= {n for n in by_name if n in chosen or _matches(args.packages_select_regex, n)}
-    skipped = set(args.packages_skip or [])
-    selected -= {n for n in by_name if n in skipped or _matches(args.packages_skip_regex, n)}
+    if args.packages_skip or args.packages_skip_regex:
+        skipped = set(args.packages_skip or [])
+        selected -= {n for n in by_name if n in skipped or _matches(args.packages_skip_regex, n)}
     if args.packages_start or args.packages_end:
         selected &= _in_range(args, ordered)
     return selected
