@@ -21,6 +21,9 @@ the rounds and using roc's Fast DDS participant profile (announcements every 0.5
 node whose first announcements the observer missed is seen up to 3 s late, noise that would swamp the
 launchers' difference (the launched processes keep Fast DDS's defaults). Each round starts once the
 launcher of the round before has ended. Times: median, min and max over the rounds; the ratio is of medians.
+A second table gives, for the same rounds, the time from the command to the tenth talker's process
+started (from /proc: the launcher's own part, without the nodes' start-up and discovery, which vary
+from start to start by more than the launchers differ).
 
 Idle CPU: after the last round, each launcher (plain output, not a terminal) runs the system for a few
 seconds, then the CPU time of the launcher's own processes (roc: roc, its guard and, for a launch file,
@@ -120,7 +123,8 @@ class Observer:
         return True
 
 
-def one_round(observer: Observer, name: str, namespace: str, env: dict[str, str]) -> float:
+def one_round(observer: Observer, name: str, namespace: str, env: dict[str, str]) -> tuple[float, float]:
+    """Seconds from the command to all ten nodes visible, and to the tenth node's process started."""
     command, expected = VARIANTS[name](namespace), nodes(namespace)
     start = time.perf_counter()
     launcher = subprocess.Popen(command, cwd=WORK, env=env, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
@@ -128,11 +132,22 @@ def one_round(observer: Observer, name: str, namespace: str, env: dict[str, str]
     try:
         if not observer.wait(lambda seen: expected <= seen, 60):
             raise SystemExit(f"{command[:3]}: the ten nodes did not appear within 60 s")
-        return time.perf_counter() - start
+        return time.perf_counter() - start, last_spawn(launcher.pid)
     finally:
         time.sleep(1)  # every node past its start-up (a node interrupted while it starts may exit uncleanly)
         launcher.send_signal(signal.SIGINT)
         launcher.wait(timeout=60)
+
+
+def last_spawn(root: int) -> float:
+    """Seconds from the launcher's start to the start of its last talker, both read from /proc (one clock,
+    in steps of 10 ms): the part of the start-up the launcher controls, without the nodes' own start-up and
+    discovery."""
+    import psutil
+
+    launcher = psutil.Process(root)
+    talkers = [p for p in launcher.children(recursive=True) if "talker" in " ".join(p.cmdline())]
+    return max(p.create_time() for p in talkers) - launcher.create_time()
 
 
 def launcher_processes(root: int) -> list[int]:
@@ -186,6 +201,15 @@ def idle_cpu(observer: Observer, name: str, namespace: str, env: dict[str, str],
             launcher.wait(timeout=60)
 
 
+def table(title: str, times: dict[str, list[float]]) -> None:
+    oracle = statistics.median(times["ros2 launch (file)"])
+    print(f"\n{title}")
+    print(f"{'variant':<24}{'median':>9}{'min':>8}{'max':>8}{'vs ros2':>9}")
+    for name, values in times.items():
+        median = statistics.median(values)
+        print(f"{name:<24}{median:>8.2f}s{min(values):>7.2f}s{max(values):>7.2f}s{median / oracle:>8.2f}x")
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rounds", type=int, default=10)
@@ -200,16 +224,15 @@ def main() -> int:
     observer = Observer()
     observer.wait(lambda _seen: False, 2)  # the observer joins the domain
     times: dict[str, list[float]] = {name: [] for name in VARIANTS}
+    spawns: dict[str, list[float]] = {name: [] for name in VARIANTS}
     for round_number in range(args.rounds):
         for name, kind in zip(VARIANTS, ("ros2_", "file_", "toml_")):
-            times[name].append(one_round(observer, name, f"{kind}{round_number}", env))
+            visible, spawned = one_round(observer, name, f"{kind}{round_number}", env)
+            times[name].append(visible)
+            spawns[name].append(spawned)
         print(f"round {round_number + 1}: " + ", ".join(f"{n} {t[-1]:.2f} s" for n, t in times.items()), flush=True)
-    oracle = statistics.median(times["ros2 launch (file)"])
-    print(f"\ntime from the command to all 10 nodes visible ({args.rounds} rounds, interleaved)")
-    print(f"{'variant':<24}{'median':>9}{'min':>8}{'max':>8}{'vs ros2':>9}")
-    for name, values in times.items():
-        median = statistics.median(values)
-        print(f"{name:<24}{median:>8.2f}s{min(values):>7.2f}s{max(values):>7.2f}s{median / oracle:>8.2f}x")
+    table(f"time from the command to all 10 nodes visible ({args.rounds} rounds, interleaved)", times)
+    table("time from the command to the 10th node's process started (the launcher's own part)", spawns)
     print(f"\nlauncher CPU while supervising the running system ({args.idle_seconds:g} s, % of one core)")
     idle = [("ros2 launch (file)", "idle_ros2", False), ("roc launch (file)", "idle_file", False),
             ("roc launch (roc.toml)", "idle_toml", False), ("roc launch (file)", "idle_view", True)]
