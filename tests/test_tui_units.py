@@ -81,3 +81,38 @@ def test_the_tui_loads_no_rclpy() -> None:
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "[]"
+
+
+def test_rows_drawn_before_their_columns_widened_are_drawn_again() -> None:
+    """A table draws rows added a moment ago before it measures them; once measured, they are drawn again
+    at their columns' widths, also when no Resize event follows (a screen kept header-wide columns)."""
+    import asyncio
+
+    from textual.app import App, ComposeResult
+    from textual.events import Resize
+
+    from roc.tui.model import Row
+    from roc.tui.widgets import ListTable
+
+    class TableNotResized(ListTable):
+        def _on_resize(self, event: Resize) -> None:
+            event.prevent_default()  # DataTable's own handler would draw every row again
+
+    class OneTable(App):
+        def compose(self) -> ComposeResult:
+            yield TableNotResized(("parameter", "type"))
+
+    async def run() -> tuple[str, str]:
+        app = OneTable()
+        async with app.run_test(size=(60, 5)) as pilot:
+            table = app.query_one(TableNotResized)
+            await pilot.pause()
+            table.show([Row("p", ("start_type_description_service", "boolean"))])
+            early = table.render_line(1).text  # before the table measured the new row
+            await pilot.pause()
+            await pilot.pause(0.2)
+            return early, table.render_line(1).text
+
+    early, settled = asyncio.run(run())
+    assert "start_type_description_service" not in early
+    assert "start_type_description_service  boolean" in settled

@@ -77,6 +77,16 @@ class ListTable(DataTable):
         for name in self.columns_names:
             self.add_column(name, key=name, width=self.widths.get(name))
 
+    def _update_dimensions(self, new_rows) -> None:
+        """DataTable's, then the rows drawn before they were measured are drawn again where their columns
+        widened: Textual 8.2 does that only on a Resize event, which does not always follow (a screen kept
+        columns as wide as their headers)."""
+        widths = [column.content_width for column in self.columns.values()]
+        super()._update_dimensions(new_rows)
+        if widths != [column.content_width for column in self.columns.values()]:
+            self._update_count += 1  # part of the key of DataTable's row and line caches
+            self.refresh()
+
     def _cells(self, row: Row) -> list:
         style = STYLES[severity(row.problems)]
         cells: list = [Text(cell, style=style) for cell in row.cells]  # never Rich markup: "[1, 2]" is a value
