@@ -42,7 +42,7 @@ fi
 # Everything whose change must redo the set-up.
 stamp_inputs() {
     local f
-    for f in "$ROOT/scripts/setup.sh" "$ROOT/scripts/fix_ros_wheels.py" "$ROOT/pyproject.toml" \
+    for f in "$ROOT/scripts/setup.sh" "$ROOT/scripts/fix_ros_wheels.py" "$ROOT/pyproject.toml" "$ROOT/bin/roc" \
              "$ROOT"/requirements/*.txt; do
         [ -f "$f" ] && printf '%s\n' "${f#"$ROOT"/}" && cat -- "$f"
     done
