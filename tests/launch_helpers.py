@@ -126,7 +126,8 @@ def describe(env: dict[str, str], names: set[str]) -> dict[str, dict]:
 
 
 def processes_with(marker: str) -> list[int]:
-    """The PIDs of live processes whose command line holds ``marker`` (a test's own temporary path)."""
+    """The PIDs of live processes whose command line holds ``marker`` (a test's own temporary path), and of
+    roc's fork servers whose environment holds it (their command line names roc's script only)."""
     found = []
     for entry in Path("/proc").iterdir():
         if not entry.name.isdigit():
@@ -134,11 +135,22 @@ def processes_with(marker: str) -> list[int]:
         try:
             command = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
             state = (entry / "stat").read_text().rsplit(")", 1)[1].split()[0]
+            if "roc/launch/forkserver.py" in command:
+                command += (entry / "environ").read_bytes().decode(errors="replace")
         except OSError:
             continue
         if marker in command and state not in ("Z", "X"):
             found.append(int(entry.name))
     return found
+
+
+def process_view(pid: int) -> dict:
+    """What ps and pkill see of a process: its name, command line, parent and process group."""
+    proc = Path(f"/proc/{pid}")
+    fields = (proc / "stat").read_text().rsplit(")", 1)[1].split()
+    return {"comm": (proc / "comm").read_text().strip(),
+            "cmdline": (proc / "cmdline").read_bytes().rstrip(b"\0").decode().replace("\0", " ").split(" "),
+            "ppid": int(fields[1]), "pgid": int(fields[2])}
 
 
 def kill_leftovers(marker: str) -> list[int]:

@@ -4,6 +4,7 @@ errors for a file or package that does not exist."""
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
@@ -14,6 +15,8 @@ from launch_helpers import (
     describe,
     kill_leftovers,
     nodes,
+    process_view,
+    processes_with,
     roc_launch,
     ros2_launch,
     skip_without_launch_library,
@@ -39,6 +42,21 @@ def demo(tmp_path_factory, launch_demo_prefix):
     kill_leftovers(str(prefix))
 
 
+def _node_processes(prefix: Path, launcher_pid: int) -> dict[str, dict]:
+    """What ps shows of each node a launcher started, by name (the launch library's temporary parameter
+    files' names left out), and whether it is in the process group of the process running the library
+    (ros2 launch itself; roc's launch runner)."""
+    views = {pid: process_view(pid) for pid in processes_with(str(prefix))}
+    library = next((pid for pid, view in views.items() if "roc.launch.runner" in view["cmdline"]), launcher_pid)
+    nodes = {}
+    for pid, view in views.items():
+        if pid != library and view["comm"] != "roc-forkserver":
+            nodes[view["comm"]] = {"cmdline": [re.sub(r"launch_params_\w+", "launch_params_", word)
+                                               for word in view["cmdline"]],
+                                   "in the library's group": view["pgid"] == os.getpgid(library)}
+    return nodes
+
+
 def _started(output: str) -> list[str]:
     """The names of the processes a launcher said it started."""
     return sorted(re.findall(r"\[INFO\] \[([\w-]+)\]: process started with pid", output))
@@ -48,7 +66,7 @@ def _started(output: str) -> list[str]:
 @pytest.mark.parametrize("file", FORMATS)
 def test_roc_and_ros2_launch_start_the_same_system(demo, tmp_path: Path, file: str) -> None:
     env, prefix = demo
-    seen, outputs = {}, {}
+    seen, outputs, processes = {}, {}, {}
     for tool, start in (("ros2", ros2_launch), ("roc", roc_launch)):
         launcher = start(PACKAGE, file, "robot:=r7", "rate:=2.5", env=env, log=tmp_path / f"{tool}.log")
         try:
@@ -56,12 +74,19 @@ def test_roc_and_ros2_launch_start_the_same_system(demo, tmp_path: Path, file: s
             wait_until(lambda: "/map_server/load_map" in roc("service", "list", env=env).stdout, 20,
                        "the map server's service")
             seen[tool] = describe(env, NODES)
+            processes[tool] = _node_processes(prefix, launcher.pid)
         finally:
             assert launcher.stop() == 0, launcher.output()
         outputs[tool] = launcher.output()
         assert not kill_leftovers(str(prefix)), f"{tool} launch left processes behind"
         wait_until(lambda: not nodes(env) & NODES, 20, "the nodes to leave the graph")
     assert seen["roc"] == seen["ros2"]
+    # roc forked the Python nodes from its warm interpreter, yet ps shows each as ros2 launch's: the same
+    # name and command line, in the process group of the process that runs the launch library
+    assert all("(warm start)" in (tmp_path / "log" / "latest_launch" / f"{name}.log").read_text()
+               for name in ("talker-1", "listener-2", "server-3"))
+    assert processes["roc"] == processes["ros2"]
+    assert sorted(processes["roc"]) == ["listener", "server", "talker"]
     talker = seen["roc"]["/r7/talker"]
     assert talker["parameters"]["/r7/talker"]["ros__parameters"]["rate"] == 2.5  # a launch argument
     assert talker["parameters"]["/r7/talker"]["ros__parameters"]["greeting"] == "hello from launch"

@@ -51,7 +51,7 @@ def test_a_signal_stops_every_process_and_exits_0(demo, tmp_path: Path, signum: 
     try:
         wait_for_nodes(env, DEMO_NODES)
         wait_until(lambda: launcher.output().count("]: ready") == 3, 30, "the nodes to be ready")
-        assert len(processes_with(str(prefix))) == 4  # the launch runner and its three nodes
+        assert len(processes_with(str(prefix))) == 5  # the launch runner, the fork server and three nodes
     finally:
         code = launcher.stop(signum)
     assert code == 0, launcher.output()

@@ -5,6 +5,7 @@ and key."""
 from __future__ import annotations
 
 import json
+import re
 import signal
 import time
 from pathlib import Path
@@ -15,6 +16,7 @@ from launch_helpers import (
     demo_env,
     kill_leftovers,
     nodes,
+    process_view,
     processes_with,
     roc_launch,
     wait_for_nodes,
@@ -91,6 +93,9 @@ def test_a_later_process_waits_for_a_service(demo, tmp_path: Path) -> None:
         launcher.wait_for_output("[robot1/listener] [INFO] [")
         params = json.loads(roc("param", "dump", "/map_server", "--format", "json", env=env).stdout)
         assert params["/map_server"]["ros__parameters"]["map"] == {"file": "office.yaml", "resolution": 0.05}
+        server, = _fork_servers(prefix)  # the nodes were forked from roc's warm interpreter
+        assert _started(launcher.output()) == {"map_server": ("server", server), "robot1/talker": ("talker", server),
+                                               "robot1/listener": ("listener", server)}
     finally:
         assert launcher.stop() == 0
     assert processes_with(str(prefix)) == []
@@ -104,6 +109,46 @@ def test_a_later_process_waits_for_a_service(demo, tmp_path: Path) -> None:
     assert output.count("process has finished cleanly") == 3
     log = (tmp_path / "log" / "latest_launch" / "robot1_talker.log").read_text()
     assert "[INFO] [" in log and "[robot1.talker]: ready" in log
+
+
+def _started(output: str) -> dict[str, tuple[str, int]]:
+    """Each process roc said it started: its name as ps shows it, and its parent's PID."""
+    started = re.findall(r"\[INFO\] \[([\w/-]+)\]: process started with pid \[(\d+)\]", output)
+    return {label: (process_view(int(pid))["comm"], process_view(int(pid))["ppid"]) for label, pid in started}
+
+
+def _fork_servers(prefix: Path) -> list[int]:
+    return [pid for pid in processes_with(str(prefix)) if process_view(pid)["comm"] == "roc-forkserver"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("how", ["--no-warm-start", "warm-start = false"])
+def test_warm_start_can_be_turned_off(demo, tmp_path: Path, how: str) -> None:
+    env, prefix = demo
+    system = SYSTEM.replace("delay = 2.0", "delay = 0.0")
+    if how.startswith("warm-start"):  # for the talker alone
+        system = system.replace('executable = "talker"', f'executable = "talker"\n{how}')
+    (tmp_path / "roc.toml").write_text(system)
+    args = ("demo", how) if how.startswith("--") else ("demo",)
+    launcher = roc_launch(*args, env=env, log=tmp_path / "roc.log")
+    try:
+        wait_for_nodes(env, {"/map_server", "/robot1/talker", "/robot1/listener"}, timeout=60)
+        launcher.wait_for_output("[robot1/listener] [INFO] [")  # the talker's messages arrive
+        started, servers = _started(launcher.output()), _fork_servers(prefix)
+    finally:
+        assert launcher.stop() == 0
+    assert processes_with(str(prefix)) == []
+    logs = tmp_path / "log" / "latest_launch"
+    warm = {name for name in ("map_server", "robot1_talker", "robot1_listener")
+            if "(warm start)" in (logs / f"{name}.log").read_text()}
+    if how.startswith("--"):  # every node is a child of roc itself
+        assert servers == [] and warm == set()
+        assert started == {"map_server": ("server", launcher.pid), "robot1/talker": ("talker", launcher.pid),
+                           "robot1/listener": ("listener", launcher.pid)}
+    else:
+        assert len(servers) == 1 and warm == {"map_server", "robot1_listener"}
+        assert started == {"map_server": ("server", servers[0]), "robot1/talker": ("talker", launcher.pid),
+                           "robot1/listener": ("listener", servers[0])}
 
 
 def test_explain_says_what_each_process_waits_for(demo, tmp_path: Path) -> None:
@@ -150,6 +195,9 @@ def test_a_failing_process_fails_the_run_unless_respawned(demo, tmp_path: Path, 
     output = launcher.output()
     assert "[ERROR] [crasher]: process has died [pid " in output and ", exit code 3, cmd '" in output
     assert (output.count("[INFO] [crasher]: process started") >= 3) == respawn
+    # a process alone with its interpreter starts as usual; one that respawns is forked from a fork server
+    log = (tmp_path / "log" / "latest_launch" / "crasher.log").read_text()
+    assert (log.count("(warm start): ") >= 3) == respawn
     assert processes_with(str(prefix)) == []
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import os
 import signal
+import socket
 import subprocess
 import sys
 import threading
@@ -63,6 +64,7 @@ def launch(launch_file: LaunchFile, options: RunOptions) -> int:
             "debug": launch_file.debug, "events_fd": events_write,
             "log_dir": str(library_logs) if library_logs else None}
     extra = {"OVERRIDE_LAUNCH_PROCESS_OUTPUT": "both"} if launch_file.show_all_output else {}
+    env = running.environment(extra)
     runners: list[subprocess.Popen] = []
 
     def stop() -> None:
@@ -73,17 +75,28 @@ def launch(launch_file: LaunchFile, options: RunOptions) -> int:
                 pass
 
     running.catch_signals(stop)  # first: no process may inherit an ignored SIGINT (a background job's)
+    server, channel = _fork_server(env) if options.warm_start else (None, None)
+    passed: tuple[int, ...] = (events_write,)
+    if server is not None and channel is not None:
+        running.guard.record(server.pid)
+        spec["warm_start"] = {"fd": channel.fileno(), "interpreter": sys.executable}
+        passed += (channel.fileno(),)
     try:
         # a process group of its own in roc's session: the terminal's signals reach roc alone, and the
         # system shares the terminal session's CPU share (its autogroup), as under ros2 launch
         runner = subprocess.Popen(_runner_command(spec), stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                  stderr=subprocess.STDOUT, pass_fds=(events_write,), process_group=0,
-                                  env=running.environment(extra))
+                                  stderr=subprocess.STDOUT, pass_fds=passed,
+                                  process_group=0, env=env)
     except BaseException:
+        if server is not None:
+            server.kill()
+            server.wait()
         running.close()
         raise
     finally:
         os.close(events_write)
+        if channel is not None:
+            channel.close()  # the runner's now: the server ends when the runner does
     runners.append(runner)
     running.guard.record(runner.pid)
     running.guard.group(runner.pid)
@@ -101,6 +114,8 @@ def launch(launch_file: LaunchFile, options: RunOptions) -> int:
     threading.Thread(target=_settle, args=(running, started, settled, runner), daemon=True).start()
     try:
         code = runner.wait()
+        if server is not None:
+            _wait_or_kill(server)
     finally:
         settled.set()
         running.stopping.set()
@@ -108,6 +123,26 @@ def launch(launch_file: LaunchFile, options: RunOptions) -> int:
             thread.join(timeout=5.0)
         running.close()
     return running.exit_code(code)
+
+
+def _fork_server(env: dict[str, str]) -> tuple[subprocess.Popen | None, socket.socket | None]:
+    """A fork server for the Python processes of the launch file (roc/launch/warm_start.py), started now so
+    that its preloads overlap the runner's start. The guess: the nodes run on roc's interpreter, which has
+    the launch library; when none does, the server ends after a while, unused."""
+    from roc.launch.warm_start import NOT_USED_SECONDS, start_server
+
+    try:
+        return start_server(sys.executable, env, NOT_USED_SECONDS)
+    except OSError:
+        return None, None
+
+
+def _wait_or_kill(process: subprocess.Popen) -> None:
+    try:
+        process.wait(timeout=5.0)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait()
 
 
 def _read_events(fd: int, running: Running, started: threading.Event) -> None:
@@ -121,7 +156,7 @@ def _read_events(fd: int, running: Running, started: threading.Event) -> None:
                 continue
             if event["event"] == "start":
                 running.guard.record(event["pid"])
-                monitor.started(event["name"], event["pid"], event["cmd"])
+                monitor.started(event["name"], event["pid"], event["cmd"], warm=event.get("warm", False))
                 started.set()
             elif event["event"] == "output":
                 monitor.output_text(event["name"], event["text"])

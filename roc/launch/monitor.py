@@ -75,14 +75,15 @@ class Monitor:
         if self.echo:
             self.output.line(f"[INFO] [{name}]: waiting for {reason}")
 
-    def started(self, name: str, pid: int, command: list[str]) -> None:
+    def started(self, name: str, pid: int, command: list[str], warm: bool = False) -> None:
         with self._lock:
             row = self._row(name)
             row.pid, row.state, row.detail, row.code = pid, "running", "", None
             row.starts += 1
             row.started_at = self.last_start = time.monotonic()
             if self.logs:
-                self.logs.note(name, f"process started with pid [{pid}]: {' '.join(command)}")
+                how = " (warm start)" if warm else ""
+                self.logs.note(name, f"process started with pid [{pid}]{how}: {' '.join(command)}")
         if self.echo:
             self.output.line(f"[INFO] [{name}]: process started with pid [{pid}]")
 

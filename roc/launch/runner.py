@@ -4,7 +4,8 @@
 roc/launch/launch_file.py) and stays outside it: this is the one module of roc that imports ``launch`` (and,
 through the launch file, ``launch_ros`` and rclpy). It prints what ros2 launch prints (the library's own
 screen output) and reports each process's start, output and exit to roc as JSON lines on the file
-descriptor ``events_fd``.
+descriptor ``events_fd``. With ``warm_start`` (a fork server's socket, from roc), its event loop forks the
+Python processes the server serves (roc/launch/warm_loop.py).
 
 It runs in a process group of its own (roc starts it so), so the terminal's Ctrl+C reaches roc alone: roc
 sends it one SIGINT, and the library, told it is non-interactive, passes SIGINT on to every process and
@@ -37,7 +38,7 @@ def _reporter(fd: int | None) -> Callable[[dict[str, Any]], None]:
     return report
 
 
-def _event_handlers(report: Callable[[dict[str, Any]], None]) -> list:
+def _event_handlers(report: Callable[[dict[str, Any]], None], forked: Callable[[int], bool]) -> list:
     from launch.actions import RegisterEventHandler
     from launch.event_handlers import OnProcessExit, OnProcessIO, OnProcessStart
 
@@ -49,7 +50,8 @@ def _event_handlers(report: Callable[[dict[str, Any]], None]) -> list:
 
     return [
         RegisterEventHandler(OnProcessStart(on_start=lambda event, _context: report(
-            {"event": "start", "name": event.process_name, "pid": event.pid, "cmd": list(event.cmd)}))),
+            {"event": "start", "name": event.process_name, "pid": event.pid, "cmd": list(event.cmd),
+             "warm": forked(event.pid)}))),
         RegisterEventHandler(OnProcessIO(on_stdout=output("stdout"), on_stderr=output("stderr"))),
         RegisterEventHandler(OnProcessExit(on_exit=lambda event, _context: report(
             {"event": "exit", "name": event.process_name, "pid": event.pid, "code": event.returncode}))),
@@ -58,6 +60,11 @@ def _event_handlers(report: Callable[[dict[str, Any]], None]) -> list:
 
 def launch(spec: dict[str, Any]) -> int:
     """Run the launch file as ros2 launch does (its arguments as ``name:=value``); the library's exit code."""
+    warm_loop = None
+    if spec.get("warm_start"):  # before the library makes its event loop
+        from roc.launch.warm_loop import install
+
+        warm_loop = install(spec["warm_start"]["fd"], spec["warm_start"]["interpreter"])
     import launch
     from launch.launch_description_sources import AnyLaunchDescriptionSource
 
@@ -68,8 +75,13 @@ def launch(spec: dict[str, Any]) -> int:
     include = launch.actions.IncludeLaunchDescription(AnyLaunchDescriptionSource(spec["path"]),
                                                       launch_arguments=list(spec["arguments"]))
     report = _reporter(spec.get("events_fd"))
-    service.include_launch_description(launch.LaunchDescription([*_event_handlers(report), include]))
-    return service.run()
+    handlers = _event_handlers(report, warm_loop.forked.__contains__ if warm_loop else lambda _pid: False)
+    service.include_launch_description(launch.LaunchDescription([*handlers, include]))
+    try:
+        return service.run()
+    finally:
+        if warm_loop is not None:
+            warm_loop.warm.close()
 
 
 def describe(spec: dict[str, Any]) -> int:

@@ -28,6 +28,7 @@ class RunOptions:
     log_base: Path | None  # None: no logs
     view: bool  # the live status view (a terminal)
     check: CheckOptions | None = None
+    warm_start: bool = True  # fork Python processes from a warm interpreter (roc/launch/warm_start.py)
 
 
 class Running:

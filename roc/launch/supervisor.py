@@ -1,7 +1,8 @@
 """roc's own process supervisor, for the systems of roc.toml: starts a process (in a process group of its
 own in roc's session: only roc signals it, and it shares the terminal session's CPU share as under ros2
-launch), reads its output into the monitor, restarts it when it has ``respawn``, and
-stops every process as ros2 launch does: SIGINT, then SIGTERM after 5 s, then SIGKILL after 5 s more."""
+launch; forked from a warm interpreter when it can, roc/launch/warm_start.py), reads its output into the
+monitor, restarts it when it has ``respawn``, and stops every process as ros2 launch does: SIGINT, then
+SIGTERM after 5 s, then SIGKILL after 5 s more."""
 
 from __future__ import annotations
 
@@ -14,6 +15,9 @@ from collections.abc import Callable
 from roc.engine.process import TaskError
 from roc.launch.monitor import Monitor
 from roc.launch.system import ProcessSpec
+from roc.launch.warm_start import ForkedProcess, WarmStart
+
+Process = subprocess.Popen | ForkedProcess
 
 SIGTERM_AFTER = 5.0
 SIGKILL_AFTER = 5.0
@@ -30,12 +34,13 @@ class Supervisor:
     def __init__(self, monitor: Monitor, environment: Callable[[dict[str, str]], dict[str, str]],
                  record: Callable[[int], None]):
         self.monitor = monitor
+        self.warm: WarmStart | None = None  # the run's fork servers, if it forks its Python processes
         self.environment = environment  # a process's extra variables -> its whole environment
         self.record = record  # tells the orphan guard about each process started
         self.stopping = monitor.stopping  # set: no more restarts, and exits are no failures
         self.failed: list[str] = []  # processes that ended with an error (and are not restarted)
         self._lock = threading.Lock()
-        self._running: dict[str, subprocess.Popen] = {}
+        self._running: dict[str, Process] = {}
         self._watchers: list[threading.Thread] = []
         self._changed = threading.Condition(self._lock)
 
@@ -49,21 +54,26 @@ class Supervisor:
             self._watchers.append(watcher)
         watcher.start()
 
-    def _spawn(self, spec: ProcessSpec, command: list[str]) -> subprocess.Popen:
-        try:
-            process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                       stderr=subprocess.STDOUT, process_group=0,
-                                       env=self.environment(spec.env))
-        except OSError as error:
-            raise TaskError(f"cannot run '{command[0]}': {error.strerror}") from None
+    def _spawn(self, spec: ProcessSpec, command: list[str]) -> Process:
+        env = self.environment(spec.env)
+        process: Process | None = None
+        if self.warm is not None and spec.warm_start:
+            process = self.warm.popen(command, env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                      stderr=subprocess.STDOUT)
+        if process is None:
+            try:
+                process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                           stderr=subprocess.STDOUT, process_group=0, env=env)
+            except OSError as error:
+                raise TaskError(f"cannot run '{command[0]}': {error.strerror}") from None
         self.record(process.pid)
         with self._lock:
             self._running[spec.label] = process
             self._changed.notify_all()
-        self.monitor.started(spec.label, process.pid, command)
+        self.monitor.started(spec.label, process.pid, command, warm=isinstance(process, ForkedProcess))
         return process
 
-    def _watch(self, spec: ProcessSpec, command: list[str], process: subprocess.Popen) -> None:
+    def _watch(self, spec: ProcessSpec, command: list[str], process: Process) -> None:
         while True:
             assert process.stdout is not None
             while data := os.read(process.stdout.fileno(), 65536):
@@ -105,7 +115,7 @@ class Supervisor:
         for watcher in watchers:
             watcher.join(timeout=SIGTERM_AFTER + SIGKILL_AFTER)
 
-    def _stop_one(self, label: str, process: subprocess.Popen) -> None:
+    def _stop_one(self, label: str, process: Process) -> None:
         for signum, grace in ((signal.SIGINT, SIGTERM_AFTER), (signal.SIGTERM, SIGKILL_AFTER),
                               (signal.SIGKILL, SIGKILL_AFTER)):
             if process.poll() is not None:

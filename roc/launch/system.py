@@ -15,6 +15,7 @@ supervisor (no launch library needed).
     env = { RCUTILS_COLORIZED_OUTPUT = "0" }
     respawn = false
     respawn-delay = 1.0             # seconds (default 1)
+    warm-start = true               # a Python node forked from a warm interpreter (roc/launch/warm_start.py)
 
     [[launch.nav.process]]
     package = "nav2_amcl"
@@ -50,7 +51,7 @@ PROCESS_KEYS: dict[str, tuple[tuple[type, ...], bool]] = {
     "package": (STRINGS, True), "executable": (STRINGS, True), "name": (STRINGS, False),
     "namespace": (STRINGS, False), "parameters": ((dict,), False), "remappings": ((dict,), False),
     "arguments": ((list,), False), "env": ((dict,), False), "respawn": ((bool,), False),
-    "respawn-delay": (NUMBER, False), "after": ((list,), False),
+    "respawn-delay": (NUMBER, False), "after": ((list,), False), "warm-start": ((bool,), False),
 }
 SYSTEM_KEYS = {"timeout": NUMBER, "process": (list, dict)}
 # kind -> the words that may follow its name (the empty tail: the short form)
@@ -84,6 +85,7 @@ class ProcessSpec:
     respawn: bool = False
     respawn_delay: float = 1.0
     after: list[Condition] = field(default_factory=list)
+    warm_start: bool = True
     where: str = ""  # file:line
 
     def ros_arguments(self) -> list[str]:
@@ -190,7 +192,8 @@ def _process(path: Path, text: str, entry: Any, start: int, system: str) -> Proc
     spec = ProcessSpec(label, entry["package"], entry["executable"], name, namespace,
                        _flatten(entry.get("parameters", {})), dict(entry.get("remappings", {})),
                        list(entry.get("arguments", [])), dict(entry.get("env", {})), entry.get("respawn", False),
-                       float(entry.get("respawn-delay", 1.0)), where=f"{path}:{start}")
+                       float(entry.get("respawn-delay", 1.0)), warm_start=entry.get("warm-start", True),
+                       where=f"{path}:{start}")
     line = key_line(text, start, "after")
     spec.after = [parse_condition(condition, path, line) for condition in entry.get("after", [])]
     return spec

@@ -10,8 +10,9 @@ import threading
 from roc.engine.events import Event, TaskFailed, TaskFinished, TaskSkipped
 from roc.launch.plan import PROCESS, LazySession, plan
 from roc.launch.running import Running, RunOptions
-from roc.launch.supervisor import Supervisor
+from roc.launch.supervisor import Supervisor, command
 from roc.launch.system import System
+from roc.launch.warm_start import WarmStart
 
 
 def _start_up_notes(running: Running, system: System):
@@ -33,6 +34,25 @@ def _start_up_notes(running: Running, system: System):
     return handler
 
 
+def _warm_start(system: System, running: Running) -> WarmStart:
+    """The fork servers for the system's Python processes, started before anything else (see
+    roc/launch/warm_start.py)."""
+    from roc.errors import RocError
+
+    starts = []
+    for spec in system.processes:
+        try:
+            if spec.warm_start:
+                starts.append((command(spec), running.environment(spec.env), spec.respawn))
+        except RocError:
+            continue  # reported when the process is due to start
+    warm = WarmStart()
+    warm.prepare(starts)
+    for pid in warm.pids:
+        running.guard.record(pid)
+    return warm
+
+
 def launch_system(system: System, options: RunOptions, use_daemon: bool, spin_time: float | None) -> int:
     from roc.engine.executor import execute
 
@@ -44,6 +64,8 @@ def launch_system(system: System, options: RunOptions, use_daemon: bool, spin_ti
     try:
         tasks = plan(system, supervisor.start, session, running.stopping.is_set)
         running.catch_signals(stop=lambda: None)  # the engine, then supervisor.wait, see running.stopping
+        if options.warm_start:  # after catch_signals: the servers must not inherit an ignored SIGINT
+            supervisor.warm = _warm_start(system, running)
         running.start_check(settled, request_stop=lambda: None)
         if running.log_directory is not None:
             running.monitor.note(f"[INFO] [launch]: All log files can be found below {running.log_directory}")
@@ -62,5 +84,7 @@ def launch_system(system: System, options: RunOptions, use_daemon: bool, spin_ti
         settled.set()
         running.stopping.set()
         supervisor.stop()
+        if supervisor.warm is not None:
+            supervisor.warm.close()
         running.close()
     return running.exit_code(0 if ok and not supervisor.failed else 1)

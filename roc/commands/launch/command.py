@@ -52,6 +52,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                           "(a launch smoke test for CI)")
     roc.add_argument("--explain", action="store_true",
                      help="for a roc.toml system: print what each process waits for, in start-up order, and exit")
+    roc.add_argument("--no-warm-start", dest="warm_start", action="store_false",
+                     help="start every process with its own fresh interpreter: no Python node is forked from roc's "
+                          "warm interpreter (see the manual's 'Warm start')")
     roc.add_argument("--plain", action="store_true",
                      help="plain lines on a terminal too, without the live status view")
     roc.add_argument("--log-base", default="log", metavar="DIR",
@@ -84,7 +87,7 @@ def _run_options(args: argparse.Namespace, title: str):
     root = find_workspace_root(Path.cwd()) or Path.cwd()
     log_base = None if args.log_base == os.devnull else root / args.log_base
     view = not args.plain and sys.stdout.isatty() and os.environ.get("TERM") != "dumb"
-    return RunOptions(title, log_base, view, check)
+    return RunOptions(title, log_base, view, check, args.warm_start)
 
 
 def run(args: argparse.Namespace) -> int:
