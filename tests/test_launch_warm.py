@@ -174,10 +174,15 @@ def test_a_server_asked_for_nothing_ends_by_itself(env) -> None:
 
 
 @pytest.mark.slow  # a server of its own: about half a second of CPU
-def test_a_server_ends_when_its_client_closes(env) -> None:
+def test_a_server_ends_when_its_client_closes_and_stops_its_children(env, tmp_path: Path) -> None:
     process, channel = start_server(sys.executable, env)
-    ForkServer(channel, sys.executable, env).close()
+    client = ForkServer(channel, sys.executable, env)
+    script = _script(tmp_path, "sleeper.py", SLEEPER)
+    forked = client.popen([str(script)], subprocess.DEVNULL, subprocess.PIPE, None, str(tmp_path))
+    assert forked.stdout is not None and forked.stdout.readline() == b"ready\n"
+    client.close()  # as when the client dies: nothing stopped the child
     assert process.wait(timeout=30) == 0
+    wait_until(lambda: _gone(forked.pid), 10, "the child to be stopped", period=0.05)
 
 
 def test_an_error_of_the_server_is_an_os_error(server, tmp_path: Path) -> None:

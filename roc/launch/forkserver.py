@@ -18,8 +18,9 @@ Protocol on the SOCK_SEQPACKET socket FD, one JSON message per packet:
 - server -> client ``{"exited": PID, "code": CODE}`` when a child ends (CODE as subprocess's
   ``returncode``: negative for a signal).
 
-It ends at the end of its socket (the client closed it, or died), or after IDLE seconds (0: never) when it
-has forked nothing by then. PADDING makes its command line long enough for its children's.
+It ends at the end of its socket (the client closed it, or died), sending SIGTERM to the children still
+running (a client that died cannot stop them), or after IDLE seconds (0: never) when it has forked nothing
+by then. PADDING makes its command line long enough for its children's.
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ import ctypes  # noqa: E402
 import io  # noqa: E402
 import json  # noqa: E402
 import selectors  # noqa: E402
+import signal  # noqa: E402
 import socket  # noqa: E402
 import warnings  # noqa: E402
 
@@ -206,8 +208,14 @@ def serve(channel: socket.socket, idle: float):
                 _pid, status = os.waitpid(key.data, 0)
                 send({"exited": key.data, "code": os.waitstatus_to_exitcode(status)})
                 continue
-            data, fds, _flags, _address = socket.recv_fds(channel, MAX_MESSAGE, 3)
+            try:
+                data, fds, _flags, _address = socket.recv_fds(channel, MAX_MESSAGE, 3)
+            except ConnectionError:
+                data = b""
             if not data:
+                for other in selector.get_map().values():
+                    if other.fileobj is not channel:
+                        os.kill(other.data, signal.SIGTERM)
                 return None
             request = json.loads(data)
             problem = check(request, fds)
