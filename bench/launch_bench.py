@@ -11,7 +11,9 @@ each round:
 
 - ``ros2 launch roc_launch_demo ten.launch.py namespace:=NS`` (the oracle, from the tests' ros2cli venv);
 - ``roc launch roc_launch_demo ten.launch.py namespace:=NS`` (the same file, the same launch library);
-- ``roc launch NS``: the same ten processes declared in roc.toml (roc's own supervisor, no launch library).
+- ``roc launch NS``: the same ten processes declared in roc.toml (roc's own supervisor, no launch library);
+- ``roc launch --no-warm-start roc_launch_demo ten.launch.py ...``: the file again, each node started by exec
+  as ros2 launch starts it (what the warm start, docs/commands/launch.md, saves).
 
 Each start uses a namespace of its own (a node that left uncleanly can stay in the observer's graph for a
 while, which must not delay or fool the next round).
@@ -26,9 +28,10 @@ started (from /proc: the launcher's own part, without the nodes' start-up and di
 from start to start by more than the launchers differ).
 
 Idle CPU: after the last round, each launcher (plain output, not a terminal) runs the system for a few
-seconds, then the CPU time of the launcher's own processes (roc: roc, its guard and, for a launch file,
-the launch runner; ros2: the ros2 launch process) over ``--idle-seconds``, in percent of one core. roc's
-live view is measured too, on a pseudo-terminal.
+seconds, then the CPU time of the launcher's own processes (roc: roc, its guard, its fork server and, for a
+launch file, the launch runner; ros2: the ros2 launch process) over ``--idle-seconds``, in percent of one
+core. roc's live view is measured too, on a pseudo-terminal. Beside it, the memory of the ten talkers: the
+sum of their PSS (each shared page counted once, split between its users), and of their RSS.
 """
 
 from __future__ import annotations
@@ -97,6 +100,8 @@ VARIANTS = {
     "roc launch (file)": lambda ns: [ROC, "launch", "--log-base", "/dev/null", "roc_launch_demo", "ten.launch.py",
                                      f"namespace:={ns}"],
     "roc launch (roc.toml)": lambda ns: [ROC, "launch", "--log-base", "/dev/null", ns],
+    "roc launch (file, cold)": lambda ns: [ROC, "launch", "--log-base", "/dev/null", "--no-warm-start",
+                                           "roc_launch_demo", "ten.launch.py", f"namespace:={ns}"],
 }
 
 
@@ -146,8 +151,11 @@ def last_spawn(root: int) -> float:
     import psutil
 
     launcher = psutil.Process(root)
-    talkers = [p for p in launcher.children(recursive=True) if "talker" in " ".join(p.cmdline())]
-    return max(p.create_time() for p in talkers) - launcher.create_time()
+    return max(p.create_time() for p in talkers(launcher)) - launcher.create_time()
+
+
+def talkers(launcher) -> list:
+    return [p for p in launcher.children(recursive=True) if "talker" in " ".join(p.cmdline())]
 
 
 def launcher_processes(root: int) -> list[int]:
@@ -158,14 +166,15 @@ def launcher_processes(root: int) -> list[int]:
     found = [parent]
     for child in parent.children(recursive=True):
         command = " ".join(child.cmdline())
-        if "roc.launch" in command or "guard.py" in command:
+        if "roc.launch" in command or "guard.py" in command or "forkserver.py" in command:
             found.append(child)
     return [p.pid for p in found]
 
 
 def idle_cpu(observer: Observer, name: str, namespace: str, env: dict[str, str], seconds: float,
-             terminal: bool) -> float:
-    """Percent of one core used by the launcher's own processes while the system runs."""
+             terminal: bool) -> tuple[float, float, float]:
+    """Percent of one core used by the launcher's own processes while the system runs; the MiB of the ten
+    talkers' PSS and RSS."""
     import psutil
 
     command, expected = VARIANTS[name](namespace), nodes(namespace)
@@ -190,7 +199,9 @@ def idle_cpu(observer: Observer, name: str, namespace: str, env: dict[str, str],
 
         before, started = cpu(), time.perf_counter()
         time.sleep(seconds)
-        return 100 * (cpu() - before) / (time.perf_counter() - started)
+        percent = 100 * (cpu() - before) / (time.perf_counter() - started)
+        memory = [p.memory_full_info() for p in talkers(psutil.Process(pid))]
+        return percent, sum(m.pss for m in memory) / 2**20, sum(m.rss for m in memory) / 2**20
     finally:
         os.kill(pid, signal.SIGINT)
         if terminal:
@@ -218,27 +229,32 @@ def main() -> int:
     reason = install_oracle(launch=True)
     if reason:
         raise SystemExit(f"ros2 launch is not available: {reason}")
-    namespaces = [f"{kind}{n}" for n in range(args.rounds) for kind in ("ros2_", "file_", "toml_")]
-    namespaces += ["idle_ros2", "idle_file", "idle_toml", "idle_view"]
+    kinds = [f"v{index}_" for index in range(len(VARIANTS))]
+    namespaces = [f"{kind}{n}" for n in range(args.rounds) for kind in kinds]
+    namespaces += ["idle_ros2", "idle_file", "idle_toml", "idle_view", "idle_cold"]
     env = environment(build(namespaces))
     observer = Observer()
     observer.wait(lambda _seen: False, 2)  # the observer joins the domain
     times: dict[str, list[float]] = {name: [] for name in VARIANTS}
     spawns: dict[str, list[float]] = {name: [] for name in VARIANTS}
     for round_number in range(args.rounds):
-        for name, kind in zip(VARIANTS, ("ros2_", "file_", "toml_")):
+        for name, kind in zip(VARIANTS, kinds):
             visible, spawned = one_round(observer, name, f"{kind}{round_number}", env)
             times[name].append(visible)
             spawns[name].append(spawned)
         print(f"round {round_number + 1}: " + ", ".join(f"{n} {t[-1]:.2f} s" for n, t in times.items()), flush=True)
     table(f"time from the command to all 10 nodes visible ({args.rounds} rounds, interleaved)", times)
     table("time from the command to the 10th node's process started (the launcher's own part)", spawns)
-    print(f"\nlauncher CPU while supervising the running system ({args.idle_seconds:g} s, % of one core)")
+    print(f"\nlauncher CPU while supervising the running system ({args.idle_seconds:g} s, % of one core), "
+          "and the ten talkers' memory")
+    print(f"{'variant':<36}{'CPU':>8}{'PSS':>10}{'RSS':>10}")
     idle = [("ros2 launch (file)", "idle_ros2", False), ("roc launch (file)", "idle_file", False),
-            ("roc launch (roc.toml)", "idle_toml", False), ("roc launch (file)", "idle_view", True)]
+            ("roc launch (roc.toml)", "idle_toml", False), ("roc launch (file)", "idle_view", True),
+            ("roc launch (file, cold)", "idle_cold", False)]
     for name, namespace, terminal in idle:
-        percent = idle_cpu(observer, name, namespace, env, args.idle_seconds, terminal)
-        print(f"{name + (', live view' if terminal else ''):<36}{percent:>6.2f} %", flush=True)
+        percent, pss, rss = idle_cpu(observer, name, namespace, env, args.idle_seconds, terminal)
+        print(f"{name + (', live view' if terminal else ''):<36}{percent:>6.2f} %{pss:>6.0f} MiB{rss:>6.0f} MiB",
+              flush=True)
     return 0
 
 
