@@ -127,6 +127,27 @@ def test_ps_sees_the_forked_script_as_the_executed_one(server, env, tmp_path: Pa
     assert executed.wait(timeout=10) == forked.wait(timeout=10) == -signal.SIGTERM
 
 
+def _threads(pid: int) -> list[str]:
+    return sorted(Path(f"/proc/{pid}/task/{tid}/comm").read_text() for tid in os.listdir(f"/proc/{pid}/task"))
+
+
+def test_a_forked_rclpy_process_has_the_threads_of_an_executed_one(server, env, tmp_path: Path) -> None:
+    """rclpy's libraries start LTTng-UST's listener threads; the server re-makes them after each fork (as
+    liblttng-ust-fork.so does), named after the process, as when it runs the script itself."""
+    script = _script(tmp_path, "rclpy_node", "import rclpy.node\n" + SLEEPER)
+    executed = subprocess.Popen([str(script)], env=env, stdout=subprocess.PIPE, process_group=0)
+    forked = server.popen([str(script)], subprocess.DEVNULL, subprocess.PIPE, None, str(tmp_path))
+    try:
+        for process in (executed, forked):
+            assert process.stdout is not None and process.stdout.readline() == b"ready\n"
+        wait_until(lambda: _threads(forked.pid) == _threads(executed.pid), 5, "the same threads", period=0.1)
+    finally:
+        for process in (executed, forked):
+            process.kill()
+    executed.wait(timeout=10)
+    forked.wait(timeout=10)
+
+
 def test_a_fork_in_the_callers_group(server, tmp_path: Path) -> None:
     script = _script(tmp_path, "sleeper.py", SLEEPER)
     forked = server.popen([str(script)], subprocess.DEVNULL, subprocess.PIPE, None, str(tmp_path),

@@ -119,9 +119,16 @@ def fork(hooks) -> int:
 def set_process_name(name: str, title: str) -> None:
     """What ``ps``, ``top``, ``pgrep`` and ``pkill`` show: the name (comm) and the command line. The command
     line is written over this process's own (setproctitle's way: a title followed by a NUL, and a
-    non-NUL last byte so that the kernel reads the title)."""
-    libc = ctypes.CDLL(None)
-    libc.prctl(PR_SET_NAME, name.encode(errors="replace")[:15], 0, 0, 0)
+    non-NUL last byte so that the kernel reads the title). The threads started before (LTTng's, re-made
+    after the fork) are named too, as a new thread takes the name of the thread that makes it."""
+    comm = name.encode(errors="replace")[:15]
+    ctypes.CDLL(None).prctl(PR_SET_NAME, comm, 0, 0, 0)
+    try:
+        for thread in os.listdir("/proc/self/task"):
+            with open(f"/proc/self/task/{thread}/comm", "wb") as thread_name:
+                thread_name.write(comm)
+    except OSError:
+        pass
     try:
         with open("/proc/self/stat", "rb") as stat:
             fields = stat.read().rsplit(b")", 1)[1].split()
