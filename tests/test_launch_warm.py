@@ -17,7 +17,7 @@ import pytest
 from launch_helpers import process_view, wait_until
 
 from roc.launch import warm_loop
-from roc.launch.warm_start import ForkServer, WarmStart, _server_key, script_interpreter, start_server
+from roc.launch.warm_start import ForkedProcess, ForkServer, WarmStart, _server_key, script_interpreter, start_server
 
 REPORT = """
 import json, os, sys
@@ -62,11 +62,26 @@ def env(tmp_path_factory) -> dict[str, str]:
 
 @pytest.fixture(scope="module")
 def server(env):
-    process, channel = start_server(sys.executable, env)
-    client = ForkServer(channel, sys.executable, env)
+    process, client = _own_server(env)
     yield client
     client.close()
     process.wait(timeout=10)
+
+
+def _own_server(env: dict[str, str]) -> tuple[subprocess.Popen, ForkServer]:
+    process, channel = start_server(sys.executable, env)
+    return process, ForkServer(channel, sys.executable, env)
+
+
+def _ready(process: subprocess.Popen | ForkedProcess) -> None:
+    assert process.stdout is not None and process.stdout.readline() == b"ready\n"
+
+
+def _fork_sleeper(server: ForkServer, args: list[str], cwd: Path, pgid: int = 0) -> ForkedProcess:
+    """``args`` (SLEEPER's script) forked, once it has said it is ready."""
+    forked = server.popen(args, subprocess.DEVNULL, subprocess.PIPE, None, str(cwd), pgid=pgid)
+    _ready(forked)
+    return forked
 
 
 def _exec(args: list[str], env: dict[str, str], cwd: Path, stdin: bytes = b"") -> tuple[int, bytes, bytes]:
@@ -113,10 +128,9 @@ def test_ps_sees_the_forked_script_as_the_executed_one(server, env, tmp_path: Pa
     script = _script(tmp_path, "sleeper_node", SLEEPER)
     args = [str(script), "--ros-args", "-p", "rate:=2.0"]
     executed = subprocess.Popen(args, env=env, stdout=subprocess.PIPE, process_group=0)
-    forked = server.popen(args, subprocess.DEVNULL, subprocess.PIPE, None, str(tmp_path))
+    forked = _fork_sleeper(server, args, tmp_path)
     try:
-        for process in (executed, forked):
-            assert process.stdout is not None and process.stdout.readline() == b"ready\n"
+        _ready(executed)
         seen, oracle = process_view(forked.pid), process_view(executed.pid)
         assert seen["comm"] == oracle["comm"] == "sleeper_node"
         assert seen["cmdline"] == oracle["cmdline"] == [sys.executable, *args]
@@ -136,10 +150,9 @@ def test_a_forked_rclpy_process_has_the_threads_of_an_executed_one(server, env, 
     liblttng-ust-fork.so does), named after the process, as when it runs the script itself."""
     script = _script(tmp_path, "rclpy_node", "import rclpy.node\n" + SLEEPER)
     executed = subprocess.Popen([str(script)], env=env, stdout=subprocess.PIPE, process_group=0)
-    forked = server.popen([str(script)], subprocess.DEVNULL, subprocess.PIPE, None, str(tmp_path))
+    forked = _fork_sleeper(server, [str(script)], tmp_path)
     try:
-        for process in (executed, forked):
-            assert process.stdout is not None and process.stdout.readline() == b"ready\n"
+        _ready(executed)
         wait_until(lambda: _threads(forked.pid) == _threads(executed.pid), 5, "the same threads", period=0.1)
     finally:
         for process in (executed, forked):
@@ -150,10 +163,8 @@ def test_a_forked_rclpy_process_has_the_threads_of_an_executed_one(server, env, 
 
 def test_a_fork_in_the_callers_group(server, tmp_path: Path) -> None:
     script = _script(tmp_path, "sleeper.py", SLEEPER)
-    forked = server.popen([str(script)], subprocess.DEVNULL, subprocess.PIPE, None, str(tmp_path),
-                          pgid=os.getpgrp())
+    forked = _fork_sleeper(server, [str(script)], tmp_path, pgid=os.getpgrp())
     try:
-        assert forked.stdout is not None and forked.stdout.readline() == b"ready\n"
         assert process_view(forked.pid)["pgid"] == os.getpgrp()
     finally:
         forked.kill()
@@ -168,11 +179,9 @@ def _gone(pid: int) -> bool:
 
 
 def test_a_server_that_dies_takes_its_children_with_it(env, tmp_path: Path) -> None:
-    process, channel = start_server(sys.executable, env)
-    client = ForkServer(channel, sys.executable, env)
+    process, client = _own_server(env)
     script = _script(tmp_path, "sleeper.py", SLEEPER)
-    forked = client.popen([str(script)], subprocess.DEVNULL, subprocess.PIPE, None, str(tmp_path))
-    assert forked.stdout is not None and forked.stdout.readline() == b"ready\n"
+    forked = _fork_sleeper(client, [str(script)], tmp_path)
     try:
         process.kill()
         assert forked.wait(timeout=10) == -signal.SIGKILL  # no supervision left: killed, not orphaned
@@ -196,11 +205,8 @@ def test_a_server_asked_for_nothing_ends_by_itself(env) -> None:
 
 @pytest.mark.slow  # a server of its own: about half a second of CPU
 def test_a_server_ends_when_its_client_closes_and_stops_its_children(env, tmp_path: Path) -> None:
-    process, channel = start_server(sys.executable, env)
-    client = ForkServer(channel, sys.executable, env)
-    script = _script(tmp_path, "sleeper.py", SLEEPER)
-    forked = client.popen([str(script)], subprocess.DEVNULL, subprocess.PIPE, None, str(tmp_path))
-    assert forked.stdout is not None and forked.stdout.readline() == b"ready\n"
+    process, client = _own_server(env)
+    forked = _fork_sleeper(client, [str(_script(tmp_path, "sleeper.py", SLEEPER))], tmp_path)
     client.close()  # as when the client dies: nothing stopped the child
     assert process.wait(timeout=30) == 0
     wait_until(lambda: _gone(forked.pid), 10, "the child to be stopped", period=0.05)

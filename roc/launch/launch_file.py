@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from roc.launch.running import Running, RunOptions
+from roc.launch.warm_start import NOT_USED_SECONDS, start_server, wait_for_server
 
 SETTLE_SECONDS = 1.0  # --check starts once no process has started for this long
 
@@ -115,7 +116,7 @@ def launch(launch_file: LaunchFile, options: RunOptions) -> int:
     try:
         code = runner.wait()
         if server is not None:
-            _wait_or_kill(server)
+            wait_for_server(server)
     finally:
         settled.set()
         running.stopping.set()
@@ -129,20 +130,10 @@ def _fork_server(env: dict[str, str]) -> tuple[subprocess.Popen | None, socket.s
     """A fork server for the Python processes of the launch file (roc/launch/warm_start.py), started now so
     that its preloads overlap the runner's start. The guess: the nodes run on roc's interpreter, which has
     the launch library; when none does, the server ends after a while, unused."""
-    from roc.launch.warm_start import NOT_USED_SECONDS, start_server
-
     try:
         return start_server(sys.executable, env, NOT_USED_SECONDS)
     except OSError:
         return None, None
-
-
-def _wait_or_kill(process: subprocess.Popen) -> None:
-    try:
-        process.wait(timeout=5.0)
-    except subprocess.TimeoutExpired:
-        process.kill()
-        process.wait()
 
 
 def _read_events(fd: int, running: Running, started: threading.Event) -> None:

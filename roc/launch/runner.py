@@ -38,7 +38,7 @@ def _reporter(fd: int | None) -> Callable[[dict[str, Any]], None]:
     return report
 
 
-def _event_handlers(report: Callable[[dict[str, Any]], None], forked: Callable[[int], bool]) -> list:
+def _event_handlers(report: Callable[[dict[str, Any]], None], forked: set[int]) -> list:
     from launch.actions import RegisterEventHandler
     from launch.event_handlers import OnProcessExit, OnProcessIO, OnProcessStart
 
@@ -51,7 +51,7 @@ def _event_handlers(report: Callable[[dict[str, Any]], None], forked: Callable[[
     return [
         RegisterEventHandler(OnProcessStart(on_start=lambda event, _context: report(
             {"event": "start", "name": event.process_name, "pid": event.pid, "cmd": list(event.cmd),
-             "warm": forked(event.pid)}))),
+             "warm": event.pid in forked}))),
         RegisterEventHandler(OnProcessIO(on_stdout=output("stdout"), on_stderr=output("stderr"))),
         RegisterEventHandler(OnProcessExit(on_exit=lambda event, _context: report(
             {"event": "exit", "name": event.process_name, "pid": event.pid, "code": event.returncode}))),
@@ -75,7 +75,7 @@ def launch(spec: dict[str, Any]) -> int:
     include = launch.actions.IncludeLaunchDescription(AnyLaunchDescriptionSource(spec["path"]),
                                                       launch_arguments=list(spec["arguments"]))
     report = _reporter(spec.get("events_fd"))
-    handlers = _event_handlers(report, warm_loop.forked.__contains__ if warm_loop else lambda _pid: False)
+    handlers = _event_handlers(report, warm_loop.forked if warm_loop else set())
     service.include_launch_description(launch.LaunchDescription([*handlers, include]))
     try:
         return service.run()

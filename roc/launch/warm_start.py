@@ -80,6 +80,15 @@ def start_server(interpreter: str, env: Mapping[str, str], not_used: float = 0.0
     return process, ours
 
 
+def wait_for_server(process: subprocess.Popen) -> None:
+    """Wait for a server to leave (it does at the end of its socket), else kill it."""
+    try:
+        process.wait(timeout=5.0)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait()
+
+
 class ForkedProcess:
     """A process forked by a fork server, with what roc and asyncio use of subprocess.Popen: ``pid``,
     ``args``, the pipes, ``returncode``, ``poll``, ``wait``, ``send_signal``, ``terminate`` and ``kill``.
@@ -321,9 +330,5 @@ class WarmStart:
         for server in self._servers.values():
             server.close()
         for process in self._processes:
-            try:
-                process.wait(timeout=5.0)
-            except subprocess.TimeoutExpired:
-                process.kill()
-                process.wait()
+            wait_for_server(process)
         self._servers, self._processes = {}, []
