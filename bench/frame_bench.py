@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""``roc frame echo map laser --once`` on a live tf tree (tests/tf_node.py: map->odom static,
+"""``roc frame echo map laser --once`` on a live tf tree (tests/nodes/tf_node.py: map->odom static,
 odom->base_link at 20 Hz, base_link->laser static), median wall times of runs interleaved:
 
 - roc with its daemon warm;
@@ -92,7 +92,7 @@ def measure(runtime: Path, runs: int) -> int:
         "roc --no-daemon": lambda: timed([*echo, "--no-daemon"], env),
         "fresh rclpy process": lambda: timed([sys.executable, "-c", LOOKUP, "map", "laser"], env),
     }
-    tree = subprocess.Popen([sys.executable, str(REPO / "tests" / "tf_node.py"), "publish"], env=env,
+    tree = subprocess.Popen([sys.executable, str(REPO / "tests" / "nodes" / "tf_node.py"), "publish"], env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     try:
         assert tree.stdout.readline().strip() == "ready"

@@ -4,7 +4,7 @@
 
     python bench/graph_bench.py [--runs 10] [--no-daemon-runs 3] [--completeness-runs 20]
 
-The graph is the demo graph of the tests (tests/graph_helpers.py: six nodes in three processes) in
+The graph is the demo graph of the tests (tests/helpers/graph.py: six nodes in three processes) in
 ROS domain 90 with localhost discovery; roc's daemon gets a private runtime directory. The ros2 CLI
 is the oracle of the tests (installed into ~/.cache/roc-tests/ros2cli-venv when missing). Runs of
 the two tools are interleaved; the table shows median wall times and the ratio roc/ros2. "warm" runs
@@ -28,7 +28,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from graph_helpers import (  # noqa: E402
+from helpers.graph import (  # noqa: E402
     BIN,
     DEMO_GRAPH,
     ORACLE_VENV,

@@ -49,7 +49,7 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests"))
-from graph_helpers import ORACLE_VENV, install_oracle  # noqa: E402
+from helpers.graph import ORACLE_VENV, install_oracle  # noqa: E402
 
 WORK = REPO / "bench" / ".work" / "launch_ws"
 DOMAIN = "97"

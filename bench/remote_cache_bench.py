@@ -37,7 +37,7 @@ sys.path.insert(0, str(HERE.parent / "tests"))
 
 from build_bench import BIN, WORK, environment  # noqa: E402
 from gen_workspace import ensure, plan  # noqa: E402
-from remote_servers import webdav  # noqa: E402
+from helpers.remote_servers import webdav  # noqa: E402
 
 BASE = WORK / "remote"
 

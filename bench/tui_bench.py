@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """``roc tui`` in a real terminal (tmux, 80x24) on a graph of 200 topics (one rclpy process publishing
-each at 2 Hz; tests/graph_node.py), roc's daemon warm:
+each at 2 Hz; tests/nodes/graph_node.py), roc's daemon warm:
 
 1. time to the first painted screen: from starting ``roc tui`` (in a pseudo-terminal of 80x24) to
    its first frame, and to the first frame that shows the graph (the header's counts and the topics), median of
@@ -149,7 +149,7 @@ def main() -> None:
     spec = {"name": "many", "publishers": [{"topic": f"bench/t{i:03d}", "type": "std_msgs/msg/String",
                                             "values": {"data": "x" * 64}, "rate_hz": RATE_HZ}
                                            for i in range(options.topics)]}
-    publisher = subprocess.Popen([sys.executable, str(REPO / "tests" / "graph_node.py"), json.dumps(spec)], env=env,
+    publisher = subprocess.Popen([sys.executable, str(REPO / "tests" / "nodes" / "graph_node.py"), json.dumps(spec)], env=env,
                                  stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     terminal = Terminal(work)
     try:

