@@ -107,13 +107,6 @@ def discovery(env: Mapping[str, str]) -> list[Finding]:
     return findings
 
 
-def discovery_range(env: Mapping[str, str]) -> str:
-    """The range rcl uses: LOCALHOST also for the deprecated ROS_LOCALHOST_ONLY=1."""
-    if env.get("ROS_LOCALHOST_ONLY") == "1":
-        return "LOCALHOST"
-    return env.get("ROS_AUTOMATIC_DISCOVERY_RANGE") or "SUBNET"
-
-
 def _packages(prefix: Path) -> set[str]:
     directory = prefix / "share" / "ament_index" / "resource_index" / "packages"
     if not directory.is_dir():

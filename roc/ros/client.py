@@ -220,6 +220,20 @@ def all_daemon_statuses() -> list[dict[str, Any]]:
     return sorted(statuses, key=lambda status: status.get("started", 0))
 
 
+def query_running_daemon(method: str, params: dict[str, Any] | None = None) -> Any:
+    """Answer a graph request through this environment's daemon if one is running (never starting one:
+    for lookups that are worth a warm graph's answer but not a cold discovery's wait); None when none runs."""
+    connection = connect(socket_path())
+    if connection is None:
+        return None
+    try:
+        if not _usable(connection):
+            return None
+        return connection.request(method, params or {})
+    finally:
+        connection.close()
+
+
 def query(method: str, params: dict[str, Any] | None = None, *, use_daemon: bool = True,
           spin_time: float | None = None) -> Any:
     """Answer a graph request, through the daemon unless ``use_daemon`` is false."""

@@ -11,7 +11,7 @@ from typing import Any
 # The variables that decide what a participant discovers: a daemon serves one set of values.
 DISCOVERY_VARIABLES = ("ROS_DOMAIN_ID", "RMW_IMPLEMENTATION", "ROS_AUTOMATIC_DISCOVERY_RANGE",
                        "ROS_STATIC_PEERS", "ROS_LOCALHOST_ONLY")
-# Daemon-less discovery lasts this long at least (see roc.ros.graph: Graph.wait_for_discovery).
+# A fresh participant's discovery lasts this long at most (see roc.ros.graph: Graph.wait_for_discovery).
 DEFAULT_SPIN_TIME = 3.5
 # A stream sends an event at least this often, so a client can act between messages.
 HEARTBEAT_SECONDS = 0.5
@@ -44,6 +44,20 @@ def is_own_node(name: str) -> bool:
 def discovery_environment(env: Mapping[str, str] | None = None) -> dict[str, str]:
     env = os.environ if env is None else env
     return {name: env.get(name, "") for name in DISCOVERY_VARIABLES}
+
+
+def discovery_range(env: Mapping[str, str] | None = None) -> str:
+    """The range rcl uses: LOCALHOST also for the deprecated ROS_LOCALHOST_ONLY=1."""
+    env = os.environ if env is None else env
+    if env.get("ROS_LOCALHOST_ONLY") == "1":
+        return "LOCALHOST"
+    return env.get("ROS_AUTOMATIC_DISCOVERY_RANGE") or "SUBNET"
+
+
+def discovery_stays_local(env: Mapping[str, str] | None = None) -> bool:
+    """Discovery reaches no other host: the LOCALHOST (or OFF) range without static peers."""
+    env = os.environ if env is None else env
+    return discovery_range(env) in ("LOCALHOST", "OFF") and not env.get("ROS_STATIC_PEERS")
 
 
 def full_name(namespace: str, name: str) -> str:

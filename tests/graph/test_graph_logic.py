@@ -4,7 +4,6 @@ fixed snapshot, the daemon's replacement check and daemon-less discovery's quiet
 from __future__ import annotations
 
 import json
-import time
 from pathlib import Path
 
 import pytest
@@ -128,36 +127,68 @@ def test_daemon_of_another_version_or_environment_is_shut_down():
         assert other.sent == ["hello", "shutdown"] and other.closed
 
 
-class FakeGraph:
-    """Stands in for roc.ros.graph.Graph: its signature changes until ``settles_at`` seconds."""
+class FakeClock:
+    """Stands in for the time module in roc.ros.graph: sleeping advances it."""
 
-    def __init__(self, settles_at: float):
-        self.start = time.monotonic()
-        self.settles_at = settles_at
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def monotonic(self) -> float:
+        return self.now
+
+    def sleep(self, seconds: float) -> None:
+        self.now += seconds
+
+
+class FakeGraph:
+    """Stands in for roc.ros.graph.Graph: its signature changes until ``settles_at``, this host's other
+    participants are all discovered from ``peers_at`` (never when None)."""
+
+    def __init__(self, clock: FakeClock, settles_at: float, peers_at: float | None):
+        self.clock, self.settles_at, self.peers_at = clock, settles_at, peers_at
 
     def signature(self):
-        elapsed = time.monotonic() - self.start
-        return round(elapsed, 2) if elapsed < self.settles_at else "settled"
+        return round(self.clock.now, 2) if self.clock.now < self.settles_at else "settled"
 
     def _complete(self):
         return True
 
+    def _local_peers_discovered(self, domain: int) -> bool:
+        return self.peers_at is not None and self.clock.now >= self.peers_at
 
-def test_discovery_waits_for_a_quiet_graph_bounded_by_spin_time():
+
+@pytest.mark.parametrize("settles_at, peers_at, period, ends_at", [
+    (0.0, 0.0, 3.5, 0.1),  # quiet and every local participant heard: at once (after the local quiet time)
+    (0.6, 0.2, 3.5, 0.7),  # still changing until 0.6 s: 0.1 s of quiet more
+    (0.0, 1.2, 3.5, 1.2),  # a participant of this host not heard yet: waits for it
+    (0.0, None, 3.5, 3.5),  # one never heard (or not countable): the whole period (--spin-time)
+    (60.0, 0.0, 2.0, 2.0),  # never quiet: the period
+])
+def test_discovery_ends_when_this_hosts_participants_are_heard_and_the_graph_is_quiet(
+        monkeypatch, settles_at, peers_at, period, ends_at):
     pytest.importorskip("rclpy")
-    from roc.ros.graph import EXTRA_SECONDS, Graph
+    from roc.ros import graph as graph_module
 
-    def waited(graph, period, quiet):
-        start = time.monotonic()
-        Graph.wait_for_discovery(graph, period, quiet)
-        return time.monotonic() - start
+    clock = FakeClock()
+    monkeypatch.setattr(graph_module, "time", clock)
+    monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+    fake = FakeGraph(clock, settles_at, peers_at)
+    fake.context = type("Context", (), {"get_domain_id": lambda self: 0})()
+    graph_module.Graph.wait_for_discovery(fake, period)
+    assert clock.now == pytest.approx(ends_at, abs=graph_module.POLL_SECONDS + 1e-9)
 
-    # Quiet from the start: returns at the period (--spin-time), not later.
-    assert 0.2 <= waited(FakeGraph(0), 0.2, 0.1) < 0.2 + EXTRA_SECONDS
-    # Changing until 0.5 s: waits past the period until quiet for 0.2 s.
-    assert 0.7 <= waited(FakeGraph(0.5), 0.2, 0.2) < 0.2 + EXTRA_SECONDS
-    # Never quiet: stops at the period plus EXTRA_SECONDS.
-    assert waited(FakeGraph(60), 0.1, 0.2) == pytest.approx(0.1 + EXTRA_SECONDS, abs=0.3)
+
+def test_beyond_this_host_discovery_waits_longer_for_quiet(monkeypatch):
+    pytest.importorskip("rclpy")
+    from roc.ros import graph as graph_module
+
+    clock = FakeClock()
+    monkeypatch.setattr(graph_module, "time", clock)
+    monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "SUBNET")
+    fake = FakeGraph(clock, 0.0, 0.0)
+    fake.context = type("Context", (), {"get_domain_id": lambda self: 0})()
+    graph_module.Graph.wait_for_discovery(fake, 3.5)
+    assert clock.now == pytest.approx(graph_module.QUIET_SECONDS, abs=graph_module.POLL_SECONDS + 1e-9)
 
 
 # ---- roc bridge: domain_bridge configs and the loop guard ------------------------------------------
@@ -235,3 +266,43 @@ def test_roc_s_participants_take_roc_s_profile_unless_the_user_chose(environment
     assert environment.get("FASTRTPS_DEFAULT_PROFILES_FILE") == ours.get(chosen, chosen)
     for profile in (PARTICIPANT_PROFILE, BRIDGE_PROFILE):  # every roc participant announces itself every 0.5 s
         assert "<leaseAnnouncement><sec>0</sec><nanosec>500000000</nanosec></leaseAnnouncement>" in profile.read_text()
+
+
+# ---- how many participants a fresh participant must hear (roc.ros.discovery) ---------------------------
+
+UDP_HEADER = "  sl  local_address rem_address   st tx_queue rx_queue tr tm->when retrnsmt   uid  timeout inode ref pointer drops\n"
+
+
+def _udp_line(port: int, inode: str) -> str:
+    return f"  1: 00000000:{port:04X} 00000000:0000 07 00000000:00000000 00:00000000 00000000     0        0 {inode} 2 0 0\n"
+
+
+def test_this_hosts_participants_are_counted_by_their_bound_discovery_ports(tmp_path: Path) -> None:
+    from roc.ros.discovery import local_participant_count, own_socket_inodes
+
+    own = next(iter(own_socket_inodes() or {"none"}))
+    table = tmp_path / "udp"
+    # domain 3: participants 0 and 2 of other processes, participant 1 this process's own; 7411 and
+    # 8161 are another domain's and a user traffic port, 7000 anything else
+    table.write_text(UDP_HEADER + _udp_line(8160, "11") + _udp_line(8164, "12") + _udp_line(8162, own)
+                     + _udp_line(8161, "13") + _udp_line(7410, "14") + _udp_line(7000, "15"))
+    assert local_participant_count(3, (table,)) == 2
+    assert local_participant_count(0, (table,)) == 1
+    assert local_participant_count(3, (tmp_path / "missing",)) is None
+
+
+class Writer:
+    def __init__(self, prefix_hex: str):
+        self.endpoint_gid = list(bytes.fromhex(prefix_hex + "000001c3"))
+
+
+def test_discovered_peers_are_the_other_fast_dds_participants_of_this_host() -> None:
+    from roc.ros.discovery import discovered_local_peers
+
+    pid = 0x7322
+    ours = Writer("010f7f01" "2273" "2073" "00000000")
+    writers = [ours, Writer("010f7f01" "8272" "ae01" "00000000"), Writer("010f7f01" "8272" "ae01" "01000000"),
+               Writer("010fc0a8" "1111" "0000" "00000000"),  # another host
+               Writer("01107f01" "1111" "0000" "00000000")]  # another vendor
+    assert discovered_local_peers(writers, pid) == 2  # one process, two participants
+    assert discovered_local_peers(writers[1:], pid) is None  # this process's own writer not seen yet

@@ -161,11 +161,9 @@ def test_every_verb_exits_1_for_a_type_not_installed_and_2_for_a_malformed_name(
     malformed = cli(*verb, "Bar", *extra, env=env)
     assert (malformed.returncode, malformed.stdout, len(malformed.stderr.splitlines())) == (2, "", 1), malformed.stderr
     status = json.loads(cli("daemon", "status", "--format", "json", env=env).stdout)
-    if verb[:2] == ["interface", "show"]:  # a message type not installed here is asked of the graph's nodes
-        assert status["running"] is True
-        stop_daemon(env)
-    else:
-        assert status["running"] is False  # decided before any daemon was asked
+    # decided before any daemon was asked: none was started (interface show asks the graph's nodes for a
+    # type not installed here only through a daemon that is already running)
+    assert status["running"] is False
 
 
 def test_pub_says_once_how_to_stop_waiting_instead_of_repeating_its_waiting_line() -> None:

@@ -14,6 +14,7 @@ from roc.doctor import environment, live_graph, network
 from roc.doctor.findings import LEVELS, Finding, summary
 from roc.errors import RocError
 from roc.render import render
+from roc.ros.protocol import discovery_range
 
 REPORT_CATEGORIES = {"environment": ("PLATFORM INFORMATION", "ROS 2 INFORMATION", "ROS ENVIRONMENT", "RMW MIDDLEWARE"),
                      "network": ("NETWORK CONFIGURATION",), "graph": ("TOPIC LIST", "QOS COMPATIBILITY LIST")}
@@ -64,7 +65,7 @@ def _finding_lines(findings: list[Finding]) -> list[str]:
 
 def run(args: argparse.Namespace) -> int:
     findings = environment.checks()
-    findings += network.checks(environment.discovery_range(os.environ))
+    findings += network.checks(discovery_range(os.environ))
     graph_findings, asked = _graph(args)
     findings += graph_findings
     result = summary(findings, args.include_warnings)

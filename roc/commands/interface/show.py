@@ -1,6 +1,7 @@
 """roc interface show: an interface definition with nested types expanded (like ros2 interface show); a
 message type that is not installed here is asked of the nodes on the graph that use it (their type
-description service), or, with ``--bag``, read from the definitions a bag holds."""
+description service) when roc's daemon is running or with ``--no-daemon``, or, with ``--bag``, read from
+the definitions a bag holds."""
 
 from __future__ import annotations
 
@@ -28,17 +29,24 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _remote(args: argparse.Namespace, type_name: str, missing: RocError) -> dict[str, Any]:
-    """The type's definition from a node on the graph; ``missing`` (the local lookup's error) when the
-    type is no message type or no node describes it."""
-    from roc.ros.client import query
+    """The type's definition from a node on the graph: asked of roc's daemon when one is running, or of
+    a participant of this process with ``--no-daemon`` (no daemon is started for it: a type installed
+    nowhere is answered at once); ``missing`` (the local lookup's error) when the type is no message
+    type or nothing describes it."""
+    from roc.ros.client import query, query_running_daemon
 
     if type_name.count("/") != 2 or type_name.split("/")[1] != "msg":
         raise missing
+    params = {"type": type_name}
     try:
-        found = query("type_description", {"type": type_name}, use_daemon=not args.no_daemon,
-                      spin_time=args.spin_time)
+        if args.no_daemon:
+            found = query("type_description", params, use_daemon=False, spin_time=args.spin_time)
+        else:
+            found = query_running_daemon("type_description", params)
     except RocError:
         raise missing from None
+    if found is None:
+        raise missing
     sources = found["sources"]
 
     def read(name: str) -> str:
