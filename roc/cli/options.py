@@ -150,9 +150,10 @@ def add_discovery_arguments(parser: argparse.ArgumentParser) -> None:
     """How a graph verb reaches the graph: through the roc daemon, or discovering it itself."""
     parser.add_argument("--no-daemon", action="store_true", help="do not use (or start) the roc daemon")
     parser.add_argument("--spin-time", type=float, metavar="SECONDS",
-                        help="without the daemon: how long to discover the graph; for topic streams, also how "
-                             "long a topic's publishers may take to appear (default: 3.5, one DDS announcement "
-                             "period; less may miss processes)")
+                        help="without the daemon: how long at most to discover the graph (discovery ends "
+                             "sooner, once every participant of this host has been heard and the graph is "
+                             "quiet); for topic streams, also how long a topic's publishers may take to "
+                             "appear (default: 3.5, one DDS announcement period)")
 
 
 QOS_PROFILES = ("unknown", "default", "system_default", "sensor_data", "services_default", "parameters",

@@ -22,6 +22,7 @@ from helpers.graph import graph_env, read_line, roc, start_nodes, stop_all, stop
 
 from roc.doctor import environment
 from roc.doctor.findings import Finding, summary
+from roc.ros.protocol import discovery_range
 
 # ---- units: the environment checks ---------------------------------------------------------------
 
@@ -39,7 +40,7 @@ def test_domain_check(value: str, level: str) -> None:
     ({"ROS_AUTOMATIC_DISCOVERY_RANGE": "OFF", "ROS_STATIC_PEERS": "10.0.0.2"}, ["ok"])])
 def test_discovery_check(env: dict[str, str], levels: list[str]) -> None:
     assert [f.level for f in environment.discovery(env)] == levels
-    assert environment.discovery_range({"ROS_LOCALHOST_ONLY": "1"}) == "LOCALHOST"
+    assert discovery_range({"ROS_LOCALHOST_ONLY": "1"}) == "LOCALHOST"
 
 
 def _prefix(root: Path, *packages: str) -> Path:
