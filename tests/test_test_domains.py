@@ -41,7 +41,7 @@ def test_no_test_hard_codes_a_domain():
     """Every test that sets ROS_DOMAIN_ID takes it from a slot (ros_domain_id or graph_env), and no two
     test files share a slot."""
     owners: dict[int, set[str]] = {}
-    for path in TESTS.glob("test_*.py"):
+    for path in TESTS.rglob("test_*.py"):
         text = path.read_text()
         assert not re.search(r"ROS_DOMAIN_ID[\"']?\s*[:=]\s*[\"']?\d", text.replace('"ROS_DOMAIN_ID", "7"', "")
                              .replace('"ROS_DOMAIN_ID": "3"', "")), path.name

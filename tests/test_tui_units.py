@@ -9,7 +9,8 @@ from pathlib import Path
 
 from textual.binding import Binding
 
-from roc.tui.model import Rates, counts, diagnoses, matches, rate_text, topic_rows, visible
+from roc.tui.model import Rates, counts, matches, rate_text, topic_rows, visible
+from roc.tui.problems import topic_diagnoses
 
 MANUAL = Path(__file__).resolve().parents[1] / "docs" / "commands" / "tui.md"
 
@@ -43,12 +44,13 @@ def test_topic_rows_count_no_hidden_endpoint_and_say_what_is_wrong() -> None:
     assert rows["/scan"].cells[:5] == ("/scan", "1", "1", "-", "-")  # the daemon's subscription left out
     assert rows["/scan"].problems[0].startswith("QoS incompatible (reliability): /lidar -> /slam")
     assert rows["/cmd"].problems == ["no publisher"]
-    assert counts(snapshot()) == {"nodes": 1, "topics": 2, "services": 0, "actions": 0, "problems": 2}
+    assert counts(snapshot()) == {"nodes": 1, "topics": 2, "services": 0, "actions": 0}
     assert len(visible(snapshot()["topics"], hidden=True)) == 3
 
 
 def test_a_lone_subscriber_without_endpoints_known_still_counts() -> None:
-    assert diagnoses({"publishers": 1, "subscribers": 0}) == ["no subscriber"]
+    assert topic_diagnoses({"publishers": 0, "subscribers": 1}) == ["no publisher"]
+    assert topic_diagnoses({"publishers": 1, "subscribers": 0}) == []  # nobody listening is no problem
 
 
 def test_filter_and_texts() -> None:

@@ -18,11 +18,12 @@ def run(args: argparse.Namespace) -> int:
     require_terminal("roc tui")
     from roc.commands.work.build import build_runner
     from roc.tui.packages import WorkspaceView
+    from roc.tui.problems import find_expectations
     from roc.workspace.root import find_workspace_root
 
     root = None if args.no_workspace else find_workspace_root(Path.cwd())
     workspace = WorkspaceView(root) if root is not None and (root / "src").is_dir() else None
-    app = RocApp(workspace=workspace, new_build=build_runner)
+    app = RocApp(workspace=workspace, new_build=build_runner, checks=find_expectations(Path.cwd()))
     try:
         return app.run() or 0
     finally:

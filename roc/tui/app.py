@@ -63,9 +63,12 @@ class RocApp(App[int]):
     COMMANDS = {GraphCommands}
 
     def __init__(self, feed: Feed | None = None, workspace: WorkspaceView | None = None,
-                 build: Start | None = None, new_build: Callable[[list[str]], Start] | None = None) -> None:
+                 build: Start | None = None, new_build: Callable[[list[str]], Start] | None = None,
+                 checks=None) -> None:
         """``build``: show this build at once (``roc work build --tui``) instead of the graph;
-        ``new_build``: how to build packages of the workspace from the TUI. With NO_COLOR set, no
+        ``new_build``: how to build packages of the workspace from the TUI; ``checks``: roc.toml's
+        ``[check]`` expectations (roc.check.expectations.CheckFile) the problems line holds the graph
+        to. With NO_COLOR set, no
         colour at all (Textual alone would draw in greys), styles such as bold and reverse kept."""
         super().__init__(ansi_color=True if os.environ.get("NO_COLOR") else None)
         self.new_build = new_build
@@ -74,6 +77,7 @@ class RocApp(App[int]):
         self.graph_screen: GraphScreen | None = None
         self.build: BuildRun | None = None
         self._first_build = build
+        self.checks = checks
 
     def on_mount(self) -> None:
         if self._first_build is not None:
@@ -83,7 +87,7 @@ class RocApp(App[int]):
             self.build = BuildRun(self._first_build)
             self.push_screen(BuildScreen(self.build))
         else:
-            self.graph_screen = GraphScreen(self.workspace)
+            self.graph_screen = GraphScreen(self.workspace, self.checks)
             self.push_screen(self.graph_screen)
 
     def open(self, kind: str, name: str) -> None:

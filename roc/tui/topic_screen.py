@@ -19,7 +19,8 @@ from textual.worker import get_current_worker
 from roc.cli.options import DEFAULT_TRUNCATE_LENGTH
 from roc.errors import RocError
 from roc.ros.rates import Sample, Window
-from roc.tui.model import TOPIC_WINDOW, Row, bandwidth_text, diagnoses, endpoint_cells, rate_text, shown_endpoints
+from roc.tui.model import TOPIC_WINDOW, Row, bandwidth_text, endpoint_cells, rate_text, shown_endpoints
+from roc.tui.problems import topic_diagnoses
 from roc.tui.widgets import ListTable, Prompt, host
 
 ECHO_SECONDS = 0.25  # the echo pane shows the latest message at most this often
@@ -97,8 +98,8 @@ class TopicScreen(Screen):
         info = {**info, **shown_endpoints(info)}
         rows = [Row(endpoint["gid"], endpoint_cells(endpoint)) for endpoint in info["publishers"] + info["subscribers"]]
         self.query_one("#endpoints", ListTable).show(rows)
-        problems = diagnoses({**info, "publishers": len(info["publishers"]), "subscribers": len(info["subscribers"]),
-                              "endpoints": info})
+        problems = topic_diagnoses({**info, "publishers": len(info["publishers"]),
+                                    "subscribers": len(info["subscribers"]), "endpoints": info})
         self.query_one("#problems", Static).update(Text("\n".join(f"! {p}" for p in problems)))
         self.type_name = self.type_name or (info["types"][0] if info["types"] else None)
         self.query_one("#title", Static).update(Text(f"topic {self.topic}  {', '.join(info['types'])}", style="bold"))
