@@ -136,9 +136,12 @@ class GraphScreen(Screen):
 
     def show_status(self, text: str) -> None:
         self.status = text
-        self.query_one("#header", Static).update(Text(text))
+        for header in self.query("#header").results(Static):  # none once the app is closing
+            header.update(Text(text))
 
     def show_snapshot(self, snapshot: dict[str, Any], usage=None) -> None:
+        if not self.query("#problems"):  # the app is closing
+            return
         self.snapshot = snapshot
         number = counts(snapshot, self.hidden)
         self.show_status("roc tui  " + "  ".join(plural(number[kind], kind.rstrip("s"))

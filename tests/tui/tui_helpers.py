@@ -46,7 +46,9 @@ def screen_lines(app) -> list[str]:
     """The screen as text lines (Textual's SVG export read back)."""
     svg = app.export_screenshot()
     lines: dict[str, list[str]] = {}
-    for line, text in re.findall(r'<text [^>]*?y="([0-9.]+)"[^>]*>([^<]*)</text>', svg):
+    for attributes, line, text in re.findall(r'<text ([^>]*?)y="([0-9.]+)"[^>]*>([^<]*)</text>', svg):
+        if "-title" in attributes:  # the window's title, not a line of the screen
+            continue
         lines.setdefault(line, []).append(text.replace("&#160;", " ").replace("&amp;", "&").replace("&lt;", "<")
                                           .replace("&gt;", ">").replace("&#x27;", "'").replace("&quot;", '"'))
     return ["".join(parts).rstrip() for _, parts in sorted(lines.items(), key=lambda item: float(item[0]))]
