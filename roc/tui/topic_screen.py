@@ -45,6 +45,8 @@ class TopicScreen(Screen):
         Binding("escape", "app.pop_screen", "back"),
         Binding("p,space", "pause", "pause/resume echo"),
         Binding("f", "field", "field"),
+        Binding("g", "plot", "plot a numeric field"),
+        Binding("u", "publish", "publish on the topic"),
     ]
     DEFAULT_CSS = """
     TopicScreen #title { height: 1; background: $primary; }
@@ -166,3 +168,21 @@ class TopicScreen(Screen):
                 self.draw_echo(force=True)
         self.app.push_screen(Prompt("field to show, sub-fields separated by '.' (empty: the whole message)",
                                     self.field), done)
+
+    def action_plot(self) -> None:
+        """Plot the field shown (when it is a number) or one typed, the latest message's first number
+        offered."""
+        from roc.tui.plotting import numeric_paths
+
+        value = self.shown["value"] if self.shown else None
+        paths = numeric_paths(value) if isinstance(value, dict) else []
+        offered = self.field if self.field in paths else paths[0] if paths else self.field
+
+        def done(text: str | None) -> None:
+            if text and text.strip():
+                host(self).open("plot", f"{self.topic} {text.strip()}")
+        choices = f" (numbers: {', '.join(paths[:6])}{', ...' if len(paths) > 6 else ''})" if paths else ""
+        self.app.push_screen(Prompt(f"field(s) of {self.topic} to plot, separated by spaces{choices}", offered), done)
+
+    def action_publish(self) -> None:
+        host(self).open("publish", self.topic)

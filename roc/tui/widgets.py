@@ -35,7 +35,7 @@ def host(widget) -> Host:
     return cast(Host, widget.app)
 
 
-WARNINGS = (NO_PUBLISHER, "duplicate name")
+WARNINGS = (NO_PUBLISHER, "duplicate name", "warning")
 
 
 def severity(problems: list[str]) -> str:
