@@ -10,6 +10,8 @@ from pathlib import Path
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-workspace", action="store_true",
                         help="do not show the packages of the workspace around the current directory")
+    parser.add_argument("--bag", metavar="PATH",
+                        help="open this bag (a directory or file): its topics, messages, and playback on the graph")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -23,7 +25,8 @@ def run(args: argparse.Namespace) -> int:
 
     root = None if args.no_workspace else find_workspace_root(Path.cwd())
     workspace = WorkspaceView(root) if root is not None and (root / "src").is_dir() else None
-    app = RocApp(workspace=workspace, new_build=build_runner, checks=find_expectations(Path.cwd()))
+    app = RocApp(workspace=workspace, new_build=build_runner, checks=find_expectations(Path.cwd()),
+                 bag=args.bag)
     try:
         return app.run() or 0
     finally:

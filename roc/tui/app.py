@@ -34,11 +34,11 @@ class RocApp(App[int]):
 
     def __init__(self, feed: Feed | None = None, workspace: WorkspaceView | None = None,
                  build: Start | None = None, new_build: Callable[[list[str]], Start] | None = None,
-                 checks=None) -> None:
+                 checks=None, bag: str | None = None) -> None:
         """``build``: show this build at once (``roc work build --tui``) instead of the graph;
         ``new_build``: how to build packages of the workspace from the TUI; ``checks``: roc.toml's
         ``[check]`` expectations (roc.check.expectations.CheckFile) the problems line holds the graph
-        to. With NO_COLOR set, no
+        to; ``bag``: a bag to open at once. With NO_COLOR set, no
         colour at all (Textual alone would draw in greys), styles such as bold and reverse kept."""
         super().__init__(ansi_color=True if os.environ.get("NO_COLOR") else None)
         self.new_build = new_build
@@ -48,6 +48,7 @@ class RocApp(App[int]):
         self.build: BuildRun | None = None
         self._first_build = build
         self.checks = checks
+        self.bag = bag
 
     def on_mount(self) -> None:
         if self._first_build is not None:
@@ -59,6 +60,8 @@ class RocApp(App[int]):
         else:
             self.graph_screen = GraphScreen(self.workspace, self.checks)
             self.push_screen(self.graph_screen)
+            if self.bag:
+                self.open("bag", self.bag)
 
     def open(self, kind: str, name: str = "") -> None:
         """Push the screen of a node, topic, service or action (``name``), or a view of the palette

@@ -78,7 +78,7 @@ class GraphScreen(Screen):
         """``checks``: roc.toml's ``[check]`` expectations (roc.check.expectations.CheckFile), or None."""
         super().__init__()
         self.workspace = workspace  # a roc.tui.packages.WorkspaceView, or None outside a workspace
-        self.watch = Watch(checks)
+        self.problem_watch = Watch(checks)
         self.processes = Processes()
         self.problems: list[Problem] = []
         self.problem_index = -1
@@ -148,9 +148,9 @@ class GraphScreen(Screen):
                                                  for kind in ("nodes", "topics", "services", "actions")))
         topics = visible(snapshot["topics"], self.hidden)
         nodes = [n["full_name"] for n in visible(snapshot["nodes"], self.hidden)]
-        self.problems = self.watch.problems(topics, nodes, self.rates.rate)
+        self.problems = self.problem_watch.problems(topics, nodes, self.rates.rate)
         self.show_problems()
-        gone = self.watch.nodes_gone(nodes)
+        gone = self.problem_watch.nodes_gone(nodes)
         self.table("nodes").show(node_rows(snapshot, self.hidden, usage or self.processes.usage, gone))
         self.table("topics").show(topic_rows(snapshot, self.rates, self.hidden))
         self.table("services").show(typed_rows(snapshot["services"], self.hidden))
@@ -233,7 +233,7 @@ class GraphScreen(Screen):
     def on_data_table_row_selected(self, event: DataTable.RowSelected) -> None:
         key = event.row_key.value
         tab = (event.data_table.id or "").removesuffix("-table")
-        row = event.data_table.rows_by_key.get(key) if isinstance(event.data_table, ListTable) else None
+        row = event.data_table.rows_by_key.get(key) if key and isinstance(event.data_table, ListTable) else None
         if key is None or row is not None and "gone" in row.problems:
             return
         if tab == "packages":
@@ -304,7 +304,7 @@ class GraphScreen(Screen):
         self.show_detail()
 
     def action_forget_gone(self) -> None:
-        self.watch.forget_gone()
+        self.problem_watch.forget_gone()
         if self.snapshot is not None:
             self.show_snapshot(self.snapshot)
 

@@ -79,9 +79,10 @@ class Processes:
         self.usage: dict[str, Usage] = {}  # node -> usage
 
     def locate(self, found: Participant) -> psutil.Process | None:
-        cached = self._found.get(found.prefix, False)
-        if cached is not False and (cached is None or cached.is_running()):
-            return cached  # type: ignore[return-value]
+        if found.prefix in self._found:
+            cached = self._found[found.prefix]
+            if cached is None or cached.is_running():
+                return cached
         process = None
         for pid in psutil.pids():
             if pid & 0xFFFF != found.pid_bits:
