@@ -210,7 +210,8 @@ class GraphScreen(Screen):
         self.query_one("#detail", Static).update(Text(text))
 
     def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
-        self.note_focus(event.data_table)
+        if event.data_table.has_focus:  # a list redrawn in the background is not the one the keys act on
+            self.note_focus(event.data_table)
         self.show_detail()
 
     def on_descendant_focus(self, event) -> None:

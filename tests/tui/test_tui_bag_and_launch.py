@@ -13,7 +13,7 @@ from build_helpers import BIN
 from graph_helpers import read_line, stop_all
 from launch_helpers import demo_env, roc_launch
 from oracles import SHARED
-from tui_helpers import live_graph, screen_name, table, until
+from tui_helpers import live_graph, picture, screen_name, table, until
 
 from roc.tui.app import RocApp
 
@@ -57,6 +57,7 @@ def test_a_bag_opened_stepped_through_and_played_on_the_graph(tmp_path) -> None:
                 await pilot.press("n")
                 await until(pilot, lambda: "data:" in message() and message() != first, what="the second message")
                 assert "message 2 of 10" in str(app.screen.query_one("#message-title").render())
+                picture(app, "bag")
                 await pilot.press("P")
                 heard = [read_line(listener, 20) for _ in range(2)]
                 assert any(line and line.startswith("Hello, world!") for line in heard), heard
@@ -88,6 +89,7 @@ def test_a_launch_run_shown_restarted_and_stopped(tmp_path, launch_demo_prefix) 
                     await until(pilot, lambda: {"talker", "listener"} <= set(rows())
                                 and all(r.cells[3] == "running" for r in rows().values()), what="the run")
                     talker_pid = rows()["talker"].cells[2]
+                    picture(app, "launch")
                     assert rows()["talker"].cells[1] == f"roc launch pair [{launcher.pid}]"
                     processes = table(app, "#processes")
                     processes.select(next(k for k, r in processes.rows_by_key.items() if r.cells[0] == "listener"))

@@ -19,6 +19,7 @@ from graph_helpers import graph_env, read_line, roc, start_nodes, stop_all
 from tui_helpers import (
     GRAPH,
     live_graph,
+    picture,
     screen_lines,
     screen_name,
     start_mortal,
@@ -76,6 +77,7 @@ def test_nodes_and_topics_side_by_side_with_cpu_rates_and_only_real_problems(gra
             assert not any(p.startswith(("/rosout", "/parameter_events", "/pose", "/talker")) for p in texts), texts
             assert len(texts) == 3, texts
             assert "3 problems" in str(app.screen.query_one("#problems").render())
+            picture(app, "system")
             # a node that dies is a problem, and p goes to it
             stop_all([mortal])
             await until(pilot, lambda: any(p.startswith("/mortal: gone since") for p in problems()), what="/mortal gone")
@@ -129,6 +131,7 @@ def test_logs_of_a_node_filtered_by_level_and_text_paused_and_followed(graph) ->
             lines = logs.visible_lines()
             assert all("[chatty_logger]" in line for line in lines), lines[:5]
             assert {"DEBUG", "INFO", "WARN", "ERROR", "FATAL"} <= {line.split()[1] for line in lines}
+            picture(app, "logs")
             await pilot.press("l", "l", "l")  # debug -> info -> warn -> error
             assert {line.split()[1] for line in logs.visible_lines()} == {"ERROR", "FATAL"}
             assert "level >= error" in str(app.screen.query_one("#title").render())
@@ -168,6 +171,7 @@ def test_a_plot_of_two_fields_zoomed_paused_and_saved_as_csv(graph, tmp_path) ->
             assert [y.values[i] for i in range(10)] == [2 * v for v in x.values[:10]]  # one message, both fields
             assert x.values[1:11] == [v + 1 for v in x.values[:10]]  # every message: x counts them
             assert plot.lost == 0
+            picture(app, "plot")
             await pilot.press("plus")
             assert plot.window == 5
             await pilot.press("minus", "minus")
@@ -203,6 +207,7 @@ def test_diagnostics_grouped_worst_first_with_history(graph) -> None:
             rows = [row.cells for row in statuses().values()]
             assert rows[0][:3] == ("ERROR", "bms-7", "power: battery"), rows
             assert [r[1] for r in rows] == ["bms-7", "lidar-2", "motor-1"]  # error, stale, ok
+            picture(app, "diagnostics")
             table(app, "#statuses").select("bms-7\tpower: battery")
             await until(pilot, lambda: len(screen.statuses["bms-7\tpower: battery"].history) >= 3, what="history")
             await pilot.press("enter")
@@ -229,6 +234,7 @@ def test_lifecycle_transition_from_the_node_screen(graph) -> None:
             app.screen.query_one("#prompt").value = "configure"
             await pilot.press("enter")
             await until(pilot, lambda: "inactive [2]" in lifecycle(), what="inactive")
+            picture(app, "lifecycle")
     asyncio.run(test())
     assert roc("lifecycle", "get", "/managed", env=env).stdout.strip() == "inactive [2]"
 

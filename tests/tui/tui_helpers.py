@@ -5,6 +5,7 @@ screen's text."""
 
 from __future__ import annotations
 
+import os
 import re
 import subprocess
 import sys
@@ -67,3 +68,12 @@ async def until_screen(app, pilot, condition: Callable[[str], bool], what: str, 
 
 def screen_name(app) -> str:
     return type(app.screen).__name__
+
+
+IMAGES = HERE.parents[1] / "docs" / "images"
+
+
+def picture(app, name: str) -> None:
+    """With ROC_UPDATE_SNAPSHOTS=1, the screen as the manual's picture docs/images/tui-NAME.svg."""
+    if os.environ.get("ROC_UPDATE_SNAPSHOTS") == "1":
+        (IMAGES / f"tui-{name}.svg").write_text(app.export_screenshot(title="roc tui"))
