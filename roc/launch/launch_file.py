@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from roc.launch.running import Running, RunOptions
+from roc.launch.status import SignalControl, serve
 from roc.launch.warm_start import NOT_USED_SECONDS, start_server, wait_for_server
 
 SETTLE_SECONDS = 1.0  # --check starts once no process has started for this long
@@ -112,12 +113,15 @@ def launch(launch_file: LaunchFile, options: RunOptions) -> int:
         thread.start()
 
     running.start_check(settled, stop)
+    status = serve(running, SignalControl(running.monitor))  # roc tui's view of the run
     threading.Thread(target=_settle, args=(running, started, settled, runner), daemon=True).start()
     try:
         code = runner.wait()
         if server is not None:
             wait_for_server(server)
     finally:
+        if status is not None:
+            status.close()
         settled.set()
         running.stopping.set()
         for thread in threads:

@@ -10,6 +10,7 @@ import threading
 from roc.engine.events import Event, TaskFailed, TaskFinished, TaskSkipped
 from roc.launch.plan import PROCESS, LazySession, plan
 from roc.launch.running import Running, RunOptions
+from roc.launch.status import SupervisorControl, serve
 from roc.launch.supervisor import Supervisor, command
 from roc.launch.system import System
 from roc.launch.warm_start import WarmStart
@@ -59,6 +60,7 @@ def launch_system(system: System, options: RunOptions, use_daemon: bool, spin_ti
     running = Running(options, echo=True)
     supervisor = Supervisor(running.monitor, running.environment, running.guard.record)
     session = LazySession(use_daemon, spin_time)
+    status = serve(running, SupervisorControl(supervisor, system))  # roc tui's view of the run
     settled = threading.Event()
     ok = False
     try:
@@ -81,6 +83,8 @@ def launch_system(system: System, options: RunOptions, use_daemon: bool, spin_ti
             settled.set()
             supervisor.wait(running.stopping)
     finally:
+        if status is not None:
+            status.close()
         settled.set()
         running.stopping.set()
         supervisor.stop()

@@ -160,11 +160,12 @@ def echo(graph, params: dict[str, Any]) -> Events:
 def publish(graph, params: dict[str, Any], prepare: Callable[[], bytes] | None = None) -> Events:
     """Publish ``params["data"]`` (base64 CDR of a ``type`` message) on ``topic``: wait for ``wait``
     matching subscriptions (``{"event": "waiting"}`` each second, at most ``max_wait`` seconds), then
-    ``times`` messages (0: until closed) at ``rate`` Hz, ``{"event": "published", "count"}`` after each,
+    ``times`` messages (0: until closed) at ``rate`` Hz (``value``, plain data, in place of ``data``: for a
+    client that loads no rclpy), ``{"event": "published", "count"}`` after each,
     keeping the publisher ``keep_alive`` seconds after the last (null: until closed). In-process only:
     ``prepare`` gives the CDR to send before each message (stamped with the time)."""
     cls = message_class(params["type"])
-    data = base64.b64decode(params["data"])
+    data = base64.b64decode(params["data"]) if "data" in params else _filled(cls, params["value"])
     profile = qos_profile({"profile": "default", **params.get("qos", {})})
     publisher = graph.node.create_publisher(cls, params["topic"], profile)
     try:
@@ -200,6 +201,13 @@ def publish(graph, params: dict[str, Any], prepare: Callable[[], bytes] | None =
             yield {"event": "heartbeat"}
     finally:
         graph.node.destroy_publisher(publisher)
+
+
+def _filled(cls, value: Any) -> bytes:
+    from roc.ros.cdr import serialize
+    from roc.ros.messages import fill_message
+
+    return serialize(fill_message(cls, value))
 
 
 def header_stamp_ns(data: bytes) -> int | None:

@@ -8,9 +8,11 @@ from typing import Any
 
 from roc.ros.calls import call, goal
 from roc.ros.dataplane import echo, frames, publish, stats
+from roc.ros.decoded import decode, values
 from roc.ros.protocol import Events
 
-STREAMS = {"echo": echo, "publish": publish, "stats": stats, "call": call, "goal": goal, "frames": frames}
+STREAMS = {"echo": echo, "publish": publish, "stats": stats, "call": call, "goal": goal, "frames": frames,
+           "values": values, "decode": decode}
 
 
 def run_on(graph, method: str, params: dict[str, Any], **in_process: Any) -> Events:

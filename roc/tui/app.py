@@ -7,50 +7,20 @@ from __future__ import annotations
 import os
 import sys
 from collections.abc import Callable
-from functools import partial
 from typing import TYPE_CHECKING
 
 from textual.app import App
 from textual.binding import Binding
-from textual.command import DiscoveryHit, Hit, Hits, Provider
 
 from roc.errors import RocError, UsageError
 from roc.tui.feed import Feed
 from roc.tui.graph_screen import GraphScreen
 from roc.tui.packages import WorkspaceView
+from roc.tui.palette import RocCommands, palette_lines
 from roc.tui.widgets import TextViewer, binding_lines
 
 if TYPE_CHECKING:  # builds load the engine's modules only when one starts
     from roc.tui.build_run import BuildRun, Start
-
-
-class GraphCommands(Provider):
-    """The palette's commands: open any node, topic, service or action by name, the tf frames, a build."""
-
-    def commands(self) -> list[tuple[str, Callable[[], object], str]]:
-        app = self.app
-        assert isinstance(app, RocApp)
-        found: list[tuple[str, Callable[[], object], str]] = [
-            ("tf frames", partial(app.open, "frame", ""), "the live tf tree")]
-        if app.workspace is not None:
-            found.append(("build the workspace", partial(app.start_build, []), "roc work build, shown live"))
-        snapshot = app.graph_screen.snapshot if app.graph_screen else None
-        for kind, noun in (("nodes", "node"), ("topics", "topic"), ("services", "service"), ("actions", "action")):
-            for entry in (snapshot or {}).get(kind, []):
-                name = entry.get("full_name", entry["name"])
-                found.append((f"{noun} {name}", partial(app.open, noun, name), f"open the {noun}"))
-        return found
-
-    async def discover(self) -> Hits:
-        for text, command, help_text in self.commands()[:20]:
-            yield DiscoveryHit(text, command, help=help_text)
-
-    async def search(self, query: str) -> Hits:
-        matcher = self.matcher(query)
-        for text, command, help_text in self.commands():
-            score = matcher.match(text)
-            if score > 0:
-                yield Hit(score, matcher.highlight(text), command, help=help_text)
 
 
 class RocApp(App[int]):
@@ -60,12 +30,15 @@ class RocApp(App[int]):
         Binding("question_mark", "help", "help"),
         Binding("colon,ctrl+p", "command_palette", "commands"),
     ]
-    COMMANDS = {GraphCommands}
+    COMMANDS = {RocCommands}
 
     def __init__(self, feed: Feed | None = None, workspace: WorkspaceView | None = None,
-                 build: Start | None = None, new_build: Callable[[list[str]], Start] | None = None) -> None:
+                 build: Start | None = None, new_build: Callable[[list[str]], Start] | None = None,
+                 checks=None, bag: str | None = None) -> None:
         """``build``: show this build at once (``roc work build --tui``) instead of the graph;
-        ``new_build``: how to build packages of the workspace from the TUI. With NO_COLOR set, no
+        ``new_build``: how to build packages of the workspace from the TUI; ``checks``: roc.toml's
+        ``[check]`` expectations (roc.check.expectations.CheckFile) the problems line holds the graph
+        to; ``bag``: a bag to open at once. With NO_COLOR set, no
         colour at all (Textual alone would draw in greys), styles such as bold and reverse kept."""
         super().__init__(ansi_color=True if os.environ.get("NO_COLOR") else None)
         self.new_build = new_build
@@ -74,6 +47,8 @@ class RocApp(App[int]):
         self.graph_screen: GraphScreen | None = None
         self.build: BuildRun | None = None
         self._first_build = build
+        self.checks = checks
+        self.bag = bag
 
     def on_mount(self) -> None:
         if self._first_build is not None:
@@ -83,28 +58,75 @@ class RocApp(App[int]):
             self.build = BuildRun(self._first_build)
             self.push_screen(BuildScreen(self.build))
         else:
-            self.graph_screen = GraphScreen(self.workspace)
+            self.graph_screen = GraphScreen(self.workspace, self.checks)
             self.push_screen(self.graph_screen)
+            if self.bag:
+                self.open("bag", self.bag)
 
-    def open(self, kind: str, name: str) -> None:
-        """Push the screen of a node, topic, service, action, or the tf frames."""
-        from roc.tui.call_screens import ActionScreen, ServiceScreen
-        from roc.tui.frames_screen import FramesScreen
-        from roc.tui.node_screen import NodeScreen
-        from roc.tui.topic_screen import TopicScreen
+    def open(self, kind: str, name: str = "") -> None:
+        """Push the screen of a node, topic, service or action (``name``), or a view of the palette
+        (roc.tui.palette.VIEWS: ``name`` holds its words)."""
+        from roc.tui import call_screens
 
-        if kind == "node":
-            self.push_screen(NodeScreen(name))
-        elif kind == "topic":
-            self.push_screen(TopicScreen(name))
+        if kind in ("nodes", "topics", "services", "actions"):
+            if self.graph_screen is not None:
+                while self.screen is not self.graph_screen and len(self.screen_stack) > 1:
+                    self.pop_screen()
+                self.graph_screen.action_show_tab(kind)
+        elif kind == "build":
+            self.start_build([])
         elif kind in ("service", "action"):
-            screen = ServiceScreen if kind == "service" else ActionScreen
+            screen = call_screens.ServiceScreen if kind == "service" else call_screens.ActionScreen
             self.push_screen(screen(name, self.type_of(kind, name)))
-        elif kind == "frame":
-            self.push_screen(FramesScreen())
+        elif kind == "publish":
+            self.push_screen(call_screens.PublishScreen(name, self.type_of("topic", name)))
+        else:
+            try:
+                self.push_screen(self.view(kind, name))
+            except RocError as error:
+                self.notify(str(error), severity="error")
+
+    def view(self, kind: str, name: str):
+        """The screen of a node or topic, or of a view that takes words (or none)."""
+        if kind == "node":
+            from roc.tui.node_screen import NodeScreen
+
+            return NodeScreen(name)
+        if kind == "topic":
+            from roc.tui.topic_screen import TopicScreen
+
+            return TopicScreen(name)
+        if kind in ("frame", "frames"):
+            from roc.tui.frames_screen import FramesScreen
+
+            return FramesScreen()
+        if kind == "logs":
+            from roc.tui.logs_screen import LogsScreen
+
+            return LogsScreen(node=name)
+        if kind == "diagnostics":
+            from roc.tui.diagnostics_screen import DiagnosticsScreen
+
+            return DiagnosticsScreen()
+        if kind == "plot":
+            from roc.tui.plot_screen import PlotScreen
+
+            words = name.split()
+            if len(words) < 2:
+                raise UsageError("plot TOPIC FIELD [FIELD...]: e.g. plot /odom pose.pose.position.x")
+            return PlotScreen([(words[0], field) for field in words[1:]])
+        if kind == "bag":
+            from roc.tui.bag_screen import BagScreen
+
+            return BagScreen(name)
+        if kind == "launch":
+            from roc.tui.launch_screen import LaunchScreen
+
+            return LaunchScreen()
+        raise UsageError(f"no view '{kind}'")
 
     def type_of(self, kind: str, name: str) -> str:
-        """A service's or action's type from the last snapshot ("" when unknown)."""
+        """A topic's, service's or action's type from the last snapshot ("" when unknown)."""
         snapshot = self.graph_screen.snapshot if self.graph_screen else None
         entry = next((e for e in (snapshot or {}).get(f"{kind}s", []) if e["name"] == name), None)
         return entry["types"][0] if entry and entry["types"] else ""
@@ -135,7 +157,8 @@ class RocApp(App[int]):
         lines = binding_lines(f"{screen} screen", self.screen.BINDINGS, self.get_key_display)
         lines += binding_lines("everywhere", self.BINDINGS, self.get_key_display)
         lines += ["Arrows, Page Up/Down, Home/End move in a list; Enter opens what is under the cursor;",
-                  "Esc goes back (or clears the filter). In an input: Enter accepts, Esc cancels."]
+                  "Esc goes back (or clears the filter). In an input: Enter accepts, Esc cancels.", "",
+                  "commands (: opens the palette, then type one):", *(f"  {line}" for line in palette_lines())]
         self.push_screen(TextViewer("keys (Esc: back)", "\n".join(lines)))
 
     async def action_quit(self) -> None:

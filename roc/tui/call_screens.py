@@ -175,3 +175,57 @@ class ActionScreen(CallScreen):
                     return
         except RocError as error:
             self.app.call_from_thread(self.say, f"error: {error}")
+
+
+class PublishScreen(CallScreen):
+    """Publish a message edited as YAML (the type's prototype to start): Ctrl+S once, Ctrl+R at a rate
+    until Ctrl+T stops it."""
+
+    BINDINGS = [Binding("escape", "app.pop_screen", "back"), Binding("ctrl+s", "send", "publish once"),
+                Binding("ctrl+r", "repeat", "publish at a rate"), Binding("ctrl+t", "stop", "stop publishing")]
+    NOUN = "publish on"
+    WHAT = "message"
+
+    def action_send(self, rate: float | None = None) -> None:
+        from roc.ros.messages import value_to_data
+        from roc.ros.types import message_class
+
+        try:
+            cls: Any = message_class(self.type_name)
+        except RocError as error:
+            self.say(f"error: {error}", restart=True)
+            return
+        message = self.message(cls)
+        if message is not None:
+            self.say("publishing..." if rate is None else f"publishing at {rate:g} Hz (Ctrl+T: stop)...", restart=True)
+            self.publish(value_to_data(message), rate)
+
+    def action_repeat(self) -> None:
+        from roc.tui.widgets import Prompt
+
+        def done(text: str | None) -> None:
+            try:
+                rate = float(text or "")
+            except ValueError:
+                rate = 0.0
+            if rate > 0:
+                self.action_send(rate)
+            elif text is not None:
+                self.say(f"error: '{text}' is no rate in Hz", restart=True)
+        self.app.push_screen(Prompt("publish at how many Hz", "1"), done)
+
+    def action_stop(self) -> None:
+        self.workers.cancel_group(self, "publish")
+        self.say("stopped")
+
+    @work(thread=True, exclusive=True, group="publish")
+    def publish(self, value: Any, rate: float | None) -> None:
+        worker = get_current_worker()
+        params = {"topic": self.target, "type": self.type_name, "value": value, "times": 1 if rate is None else 0,
+                  "rate": rate, "keep_alive": 0.5}
+        try:
+            for event in host(self).feed.stream("publish", params, lambda: worker.is_cancelled):
+                if event["event"] == "published" and not worker.is_cancelled:
+                    self.app.call_from_thread(self.say, f"published message {event['count']}", event["count"] > 1)
+        except RocError as error:
+            self.app.call_from_thread(self.say, f"error: {error}")

@@ -8,10 +8,14 @@ is left out of the rates instead.
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Callable, Iterator
 from typing import Any
 
+from roc.errors import RocError
 from roc.ros.client import DaemonError, Session, start_daemon
+
+CALL_TIMEOUT = 5.0  # seconds for a node's service to answer, as roc's verbs wait
 
 
 class Feed:
@@ -51,6 +55,17 @@ class Feed:
                     yield response
         finally:
             connection.close()
+
+
+    def call(self, service: str, type_name: str, request: dict[str, Any], timeout: float = CALL_TIMEOUT) -> Any:
+        """Call a service with a request given as plain data; its response as plain data (the daemon
+        fills and decodes them: no rclpy here)."""
+        deadline = time.monotonic() + timeout
+        params = {"service": service, "type": type_name, "request_data": request, "rate": None}
+        for event in self.stream("call", params, lambda: time.monotonic() > deadline):
+            if event["event"] == "response":
+                return event["value"]
+        raise RocError(f"'{service}' did not answer within {timeout:g} s")
 
 
 def measure_rates(feed: Feed, topics: list[str], take: Callable[[dict[str, Any]], None],

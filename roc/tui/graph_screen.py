@@ -1,6 +1,7 @@
-"""The first screen: the graph at a glance. Nodes, topics (type, publishers, subscribers, live rate
-and bandwidth), services and actions in tabs, and a workspace's packages when ``roc tui`` runs in
-one; counts in the header; topics with problems marked; ``/`` filters the list shown."""
+"""The first screen: the system at a glance. Nodes (with their process's CPU and memory) beside topics
+(publishers, subscribers, live rate and bandwidth, type), then services, actions and a workspace's
+packages in tabs; counts in the header; a line that counts the real problems (roc.tui.problems), ``p``
+going to each in turn; ``/`` filters the list shown."""
 
 from __future__ import annotations
 
@@ -10,6 +11,8 @@ from rich.text import Text
 from textual import work
 from textual.app import ComposeResult
 from textual.binding import Binding
+from textual.containers import Container
+from textual.events import Resize
 from textual.screen import Screen
 from textual.widgets import DataTable, Footer, Input, Static, TabbedContent, TabPane
 from textual.worker import get_current_worker
@@ -18,18 +21,22 @@ from roc.errors import RocError
 from roc.ros.present import plural
 from roc.tui.feed import measure_rates
 from roc.tui.model import Rates, counts, node_rows, topic_rows, typed_rows, visible
+from roc.tui.problems import Problem, Watch
+from roc.tui.processes import Processes
 from roc.tui.widgets import ListTable, host
 
 REFRESH_SECONDS = 1.0
 # the topics' columns whose values change every second, at the widths of their longest values
-TOPIC_WIDTHS = {"pub": 3, "sub": 3, "rate": 9, "bandwidth": 11}
-# tab id -> (title, columns, marks)
+WIDTHS = {"topics": {"pub": 3, "sub": 3, "rate": 9, "bandwidth": 11}, "nodes": {"cpu": 6, "mem": 5}}
+# list -> (columns, marks); nodes and topics side by side in the first tab, the others a tab each
 LISTS = {
-    "nodes": ("Nodes", ("node",), True),
-    "topics": ("Topics", ("topic", "pub", "sub", "rate", "bandwidth", "type"), True),
-    "services": ("Services", ("service", "type"), False),
-    "actions": ("Actions", ("action", "type"), False),
+    "nodes": (("node", "cpu", "mem"), True),
+    "topics": (("topic", "pub", "sub", "rate", "bandwidth", "type"), True),
+    "services": (("service", "type"), False),
+    "actions": (("action", "type"), False),
 }
+SYSTEM = ("nodes", "topics")
+NARROW = 100  # below this many columns, the nodes are above the topics instead of beside them
 
 
 class GraphScreen(Screen):
@@ -45,6 +52,8 @@ class GraphScreen(Screen):
         Binding("3", "show_tab('services')", "services", show=False),
         Binding("4", "show_tab('actions')", "actions", show=False),
         Binding("5", "show_tab('packages')", "packages (in a workspace)", show=False),
+        Binding("p", "next_problem", "next problem"),
+        Binding("c", "forget_gone", "forget the nodes gone", show=False),
         Binding("f", "frames", "tf frames"),
         Binding("b", "build", "build the package under the cursor and what it needs (Packages)", show=False),
         Binding("B", "build(True)", "build the whole workspace (Packages)", show=False),
@@ -53,15 +62,27 @@ class GraphScreen(Screen):
     DEFAULT_CSS = """
     GraphScreen { overflow: hidden; }
     GraphScreen #header { height: 1; background: $primary; color: $text; }
+    GraphScreen #problems { height: 1; }
     GraphScreen #detail { height: 2; color: $text-muted; }
     GraphScreen #filter { display: none; }
     GraphScreen ListTable { height: 1fr; }
     GraphScreen #tabs { height: 1fr; }
+    GraphScreen #system { layout: horizontal; height: 1fr; }
+    GraphScreen #system.narrow { layout: vertical; }
+    GraphScreen #system #nodes-table { width: 36; }
+    GraphScreen #system.narrow #nodes-table { width: 1fr; height: 2fr; }
+    GraphScreen #system.narrow #topics-table { height: 3fr; }
     """
 
-    def __init__(self, workspace=None) -> None:
+    def __init__(self, workspace=None, checks=None) -> None:
+        """``checks``: roc.toml's ``[check]`` expectations (roc.check.expectations.CheckFile), or None."""
         super().__init__()
         self.workspace = workspace  # a roc.tui.packages.WorkspaceView, or None outside a workspace
+        self.problem_watch = Watch(checks)
+        self.processes = Processes()
+        self.problems: list[Problem] = []
+        self.problem_index = -1
+        self.current = "topics"  # the list the keys act on (the focused one)
         self.rates = Rates()
         self.hidden = False
         self.snapshot: dict[str, Any] | None = None
@@ -71,17 +92,28 @@ class GraphScreen(Screen):
 
     def compose(self) -> ComposeResult:
         yield Static(self.status, id="header")
-        with TabbedContent(initial="topics", id="tabs"):
-            for tab, (title, columns, marks) in LISTS.items():
-                with TabPane(title, id=tab):
-                    widths = TOPIC_WIDTHS if tab == "topics" else None
-                    yield ListTable(columns, marks=marks, id=f"{tab}-table", widths=widths)
+        yield Static("", id="problems")
+        with TabbedContent(initial="system-tab", id="tabs"):
+            with TabPane("System", id="system-tab"), Container(id="system"):
+                for name in SYSTEM:
+                    yield self.list_table(name)
+            for name in ("services", "actions"):
+                with TabPane(name.title(), id=name):
+                    yield self.list_table(name)
             if self.workspace is not None:
                 with TabPane("Packages", id="packages"):
                     yield ListTable(self.workspace.COLUMNS, marks=True, id="packages-table")
         yield Static("", id="detail")
         yield Input(placeholder="filter: words that must all appear (Enter: keep, Esc: clear)", id="filter")
         yield Footer()
+
+    @staticmethod
+    def list_table(name: str) -> ListTable:
+        columns, marks = LISTS[name]
+        return ListTable(columns, marks=marks, id=f"{name}-table", widths=WIDTHS.get(name))
+
+    def on_resize(self, event: Resize) -> None:
+        self.query_one("#system").set_class(event.size.width < NARROW, "narrow")
 
     def on_mount(self) -> None:
         self.poll()
@@ -99,28 +131,47 @@ class GraphScreen(Screen):
         except RocError as error:
             self.app.call_from_thread(self.show_status, f"roc daemon: {error}")
             return
-        self.app.call_from_thread(self.show_snapshot, snapshot)
+        usage = self.processes.update(snapshot)  # psutil: off the app's thread
+        self.app.call_from_thread(self.show_snapshot, snapshot, usage)
 
     def show_status(self, text: str) -> None:
         self.status = text
-        self.query_one("#header", Static).update(Text(text))
+        for header in self.query("#header").results(Static):  # none once the app is closing
+            header.update(Text(text))
 
-    def show_snapshot(self, snapshot: dict[str, Any]) -> None:
+    def show_snapshot(self, snapshot: dict[str, Any], usage=None) -> None:
+        if not self.query("#problems"):  # the app is closing
+            return
         self.snapshot = snapshot
         number = counts(snapshot, self.hidden)
-        problems = f"  {plural(number['problems'], 'topic')} with problems" if number["problems"] else ""
         self.show_status("roc tui  " + "  ".join(plural(number[kind], kind.rstrip("s"))
-                                                 for kind in ("nodes", "topics", "services", "actions")) + problems)
-        self.table("nodes").show(node_rows(snapshot, self.hidden))
+                                                 for kind in ("nodes", "topics", "services", "actions")))
+        topics = visible(snapshot["topics"], self.hidden)
+        nodes = [n["full_name"] for n in visible(snapshot["nodes"], self.hidden)]
+        self.problems = self.problem_watch.problems(topics, nodes, self.rates.rate)
+        self.show_problems()
+        gone = self.problem_watch.nodes_gone(nodes)
+        self.table("nodes").show(node_rows(snapshot, self.hidden, usage or self.processes.usage, gone))
         self.table("topics").show(topic_rows(snapshot, self.rates, self.hidden))
         self.table("services").show(typed_rows(snapshot["services"], self.hidden))
         self.table("actions").show(typed_rows(snapshot["actions"], self.hidden))
-        published = sorted(t["name"] for t in visible(snapshot["topics"], self.hidden) if t["publishers"])
+        published = sorted(t["name"] for t in topics if t["publishers"])
         if published != self.measured:
             self.measured = published
             self.rates.keep(set(published))
             self.measure(published)
         self.show_detail()
+
+    def show_problems(self) -> None:
+        """The problems line: how many, the first (or the one ``p`` went to), and the key."""
+        line = self.query_one("#problems", Static)
+        if not self.problems:
+            line.update(Text("no problems", style="green"))
+            return
+        index = self.problem_index if 0 <= self.problem_index < len(self.problems) else 0
+        severity = "bold red" if any(p.severity == "error" for p in self.problems) else "yellow"
+        line.update(Text.assemble((f"{plural(len(self.problems), 'problem')}", severity),
+                                  f" ({index + 1}/{len(self.problems)}, p: next)  ", self.problems[index].text))
 
     @work(thread=True, exclusive=True, group="rates")
     def measure(self, topics: list[str]) -> None:
@@ -140,11 +191,13 @@ class GraphScreen(Screen):
                 self.notify(f"workspace {self.workspace.root}: {error}", severity="error", timeout=10)
 
     # -- views -----------------------------------------------------------------------------------
-    def table(self, tab: str) -> ListTable:
-        return self.query_one(f"#{tab}-table", ListTable)
+    def table(self, name: str) -> ListTable:
+        return self.query_one(f"#{name}-table", ListTable)
 
     def active_tab(self) -> str:
-        return self.query_one("#tabs", TabbedContent).active
+        """The list the keys act on: nodes or topics (the first tab), services, actions, packages."""
+        tab = self.query_one("#tabs", TabbedContent).active
+        return self.current if tab == "system-tab" else tab
 
     def show_detail(self) -> None:
         """Under the list: the problems of the row under the cursor, or how many rows the filter keeps."""
@@ -156,19 +209,33 @@ class GraphScreen(Screen):
                     + (f"  |  {text}" if text else ""))
         self.query_one("#detail", Static).update(Text(text))
 
-    def on_data_table_row_highlighted(self, _event: DataTable.RowHighlighted) -> None:
+    def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
+        if event.data_table.has_focus:  # a list redrawn in the background is not the one the keys act on
+            self.note_focus(event.data_table)
         self.show_detail()
 
+    def on_descendant_focus(self, event) -> None:
+        if isinstance(event.widget, ListTable):
+            self.note_focus(event.widget)
+
+    def note_focus(self, table: DataTable) -> None:
+        name = (table.id or "").removesuffix("-table")
+        if name in SYSTEM and self.current != name:
+            self.current = name
+            self.query_one("#filter", Input).value = self.table(name).filter
+            self.show_detail()
+
     def on_tabbed_content_tab_activated(self, event: TabbedContent.TabActivated) -> None:
-        table = self.table(event.pane.id or "topics")
+        table = self.table(self.active_tab())
         table.focus()
         self.query_one("#filter", Input).value = table.filter
         self.show_detail()
 
     def on_data_table_row_selected(self, event: DataTable.RowSelected) -> None:
         key = event.row_key.value
-        tab = self.active_tab()
-        if key is None:
+        tab = (event.data_table.id or "").removesuffix("-table")
+        row = event.data_table.rows_by_key.get(key) if key and isinstance(event.data_table, ListTable) else None
+        if key is None or row is not None and "gone" in row.problems:
             return
         if tab == "packages":
             host(self).open_package(key)
@@ -210,9 +277,37 @@ class GraphScreen(Screen):
         tabs = self.tabs()
         self.action_show_tab(tabs[(tabs.index(self.active_tab()) + step) % len(tabs)])
 
-    def action_show_tab(self, tab: str) -> None:
-        if tab in self.tabs():
-            self.query_one("#tabs", TabbedContent).active = tab
+    def action_show_tab(self, name: str) -> None:
+        if name not in self.tabs():
+            return
+        if name in SYSTEM:
+            self.current = name
+            self.query_one("#tabs", TabbedContent).active = "system-tab"
+            self.table(name).focus()
+            self.query_one("#filter", Input).value = self.table(name).filter
+            self.show_detail()
+        else:
+            self.query_one("#tabs", TabbedContent).active = name
+
+    def action_next_problem(self) -> None:
+        """The cursor to the row of the next problem (a topic or a node), its text on the problems line."""
+        if not self.problems:
+            self.notify("no problems")
+            return
+        self.problem_index = (self.problem_index + 1) % len(self.problems)
+        problem = self.problems[self.problem_index]
+        self.action_show_tab(f"{problem.kind}s")
+        table = self.table(f"{problem.kind}s")
+        if problem.name not in table.rows_by_key and table.filter:
+            table.set_filter("")
+        table.select(problem.name)
+        self.show_problems()
+        self.show_detail()
+
+    def action_forget_gone(self) -> None:
+        self.problem_watch.forget_gone()
+        if self.snapshot is not None:
+            self.show_snapshot(self.snapshot)
 
     def action_frames(self) -> None:
         host(self).open("frame", "")

@@ -1,5 +1,5 @@
 """What ``roc tui`` shows, as plain data: the rows of each list made from the daemon's answers, the
-live rates and bandwidths of topics, the diagnoses, the filter. No Textual here (unit-testable).
+live rates and bandwidths of topics, the nodes' processes, the filter. No Textual here (unit-testable).
 """
 
 from __future__ import annotations
@@ -7,15 +7,15 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from roc.ros.present import is_hidden, problem_line, topic_problems
+from roc.ros.present import is_hidden
 from roc.ros.rates import Window, samples, size_text
+from roc.tui.problems import topic_diagnoses
+from roc.tui.processes import Usage, cpu_text, memory_text
 
 # Messages kept per topic for the list's rates: enough for a steady rate, little memory for 200 topics
 # (roc topic hz keeps 10000 of one topic; the topic screen does too).
 LIST_WINDOW = 500
 TOPIC_WINDOW = 10000
-NO_PUBLISHER = "no publisher"
-NO_SUBSCRIBER = "no subscriber"
 
 
 @dataclass
@@ -47,20 +47,6 @@ def with_shown_endpoints(topic: dict[str, Any]) -> dict[str, Any]:
     endpoints = shown_endpoints(topic["endpoints"])
     return {**topic, "endpoints": endpoints, "publishers": len(endpoints["publishers"]),
             "subscribers": len(endpoints["subscribers"])}
-
-
-def diagnoses(topic: dict[str, Any]) -> list[str]:
-    """What is wrong with a topic of a ``snapshot`` (with endpoints): nobody publishes or nobody
-    listens, and the QoS and type problems ``roc topic info -v`` reports (roc.ros.present)."""
-    found = []
-    if not topic["publishers"]:
-        found.append(NO_PUBLISHER)
-    if not topic["subscribers"]:
-        found.append(NO_SUBSCRIBER)
-    endpoints = topic.get("endpoints")
-    if endpoints:
-        found += [problem_line(p) for p in topic_problems(endpoints)]
-    return found
 
 
 def rate_text(rate: float | None) -> str:
@@ -108,14 +94,21 @@ def visible(entries: list[dict[str, Any]], hidden: bool) -> list[dict[str, Any]]
 
 def topic_rows(snapshot: dict[str, Any], rates: Rates, hidden: bool = False) -> list[Row]:
     return [Row(t["name"], (t["name"], str(t["publishers"]), str(t["subscribers"]), rate_text(rates.rate(t["name"])),
-                            bandwidth_text(rates.bandwidth(t["name"])), ", ".join(t["types"])), diagnoses(t))
+                            bandwidth_text(rates.bandwidth(t["name"])), ", ".join(t["types"])), topic_diagnoses(t))
             for t in visible(snapshot["topics"], hidden)]
 
 
-def node_rows(snapshot: dict[str, Any], hidden: bool = False) -> list[Row]:
+def node_rows(snapshot: dict[str, Any], hidden: bool = False, usage: dict[str, Usage] | None = None,
+              gone: dict[str, float] | None = None) -> list[Row]:
+    """Each node with its process's CPU (% of a core; ``remote`` on another host) and resident memory
+    (shared by the nodes of one process); then the nodes ``gone`` (name -> when last seen)."""
     names = [n["full_name"] for n in snapshot["nodes"]]
-    return [Row(n["full_name"], (n["full_name"],), ["duplicate name"] if names.count(n["full_name"]) > 1 else [])
+    usage = usage or {}
+    rows = [Row(n["full_name"], (n["full_name"], cpu_text(usage.get(n["full_name"])),
+                                 memory_text(usage.get(n["full_name"]))),
+                ["duplicate name"] if names.count(n["full_name"]) > 1 else [])
             for n in visible(snapshot["nodes"], hidden)]
+    return rows + [Row(name, (name, "gone", ""), ["gone"]) for name in sorted(gone or {})]
 
 
 def typed_rows(entries: list[dict[str, Any]], hidden: bool = False) -> list[Row]:
@@ -124,12 +117,8 @@ def typed_rows(entries: list[dict[str, Any]], hidden: bool = False) -> list[Row]
 
 
 def counts(snapshot: dict[str, Any], hidden: bool = False) -> dict[str, int]:
-    """How many of each kind the header shows, and how many topics have a problem."""
-    topics = visible(snapshot["topics"], hidden)
-    return {"nodes": len(visible(snapshot["nodes"], hidden)), "topics": len(topics),
-            "services": len(visible(snapshot["services"], hidden)),
-            "actions": len(visible(snapshot["actions"], hidden)),
-            "problems": sum(1 for t in topics if diagnoses(t))}
+    """How many of each kind the header shows."""
+    return {kind: len(visible(snapshot[kind], hidden)) for kind in ("nodes", "topics", "services", "actions")}
 
 
 def endpoint_cells(endpoint: dict[str, Any]) -> tuple[str, ...]:

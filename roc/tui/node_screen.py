@@ -1,5 +1,6 @@
 """A node: what it publishes, subscribes, serves and calls (Enter opens one), and its parameters:
-Enter edits a value (typed as ``roc param set`` types it), ``d`` dumps them to a YAML file."""
+Enter edits a value (typed as ``roc param set`` types it), ``d`` dumps them to a YAML file; a managed
+node's lifecycle state, ``t`` triggering a transition (as ``roc lifecycle set``); ``l`` its logs."""
 
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ from textual.binding import Binding
 from textual.screen import Screen
 from textual.widgets import DataTable, Footer, Static
 
+from roc.commands.lifecycle.managed import GET_STATE
 from roc.commands.param.dump import nested
 from roc.commands.param.set import parse_value
 from roc.errors import RocError
@@ -51,20 +53,26 @@ class NodeScreen(Screen):
         Binding("e", "edit", "edit parameter"),
         Binding("d", "dump", "dump parameters"),
         Binding("r", "reload", "reload"),
+        Binding("t", "transition", "lifecycle transition (a managed node)"),
+        Binding("l", "logs", "the node's logs"),
     ]
     DEFAULT_CSS = """
     NodeScreen #title { height: 1; background: $primary; }
     NodeScreen ListTable { height: 1fr; }
     NodeScreen .caption { height: 1; color: $text-muted; }
+    NodeScreen #lifecycle { height: auto; }
     """
 
     def __init__(self, node: str) -> None:
         super().__init__()
         self.node = node
         self.parameters: dict[str, dict[str, Any]] = {}  # name -> {type, value}
+        self.managed = False
+        self.transitions: list[dict[str, Any]] = []  # available now: {transition: {id, label}, ...}
 
     def compose(self) -> ComposeResult:
         yield Static(Text(f"node {self.node}", style="bold"), id="title")
+        yield Static("", id="lifecycle")
         yield Static("interfaces (Enter: open)", classes="caption")
         yield ListTable(("what", "name", "type"), id="interfaces")
         yield Static("parameters (Enter or e: edit, d: dump to a file)", classes="caption", id="params-caption")
@@ -89,6 +97,10 @@ class NodeScreen(Screen):
         rows = [Row(f"{kind}:{side}:{entry['name']}", (what, entry["name"], ", ".join(entry["types"])))
                 for side, what, kind in SIDES for entry in info[side]]
         self.app.call_from_thread(self.query_one("#interfaces", ListTable).show, rows)
+        self.managed = any(entry["name"] == f"{self.node}/get_state" and GET_STATE in entry["types"]
+                           for entry in info["service_servers"])
+        if self.managed:
+            self.load_lifecycle()
         try:
             names = [p["name"] for p in feed.query("param_list", {"node": self.node})[0]["parameters"]]
             values = feed.query("param_get", {"node": self.node, "names": names}) if names else []
@@ -98,6 +110,55 @@ class NodeScreen(Screen):
         self.parameters = dict(zip(names, values))
         self.app.call_from_thread(self.query_one("#parameters", ListTable).show, [
             Row(name, (name, value["type"], value_text(value["value"]))) for name, value in self.parameters.items()])
+
+    def load_lifecycle(self) -> None:
+        """The managed node's state and the transitions it can take (in a worker's thread)."""
+        feed = host(self).feed
+        try:
+            state = feed.call(f"{self.node}/get_state", GET_STATE, {})["current_state"]
+            self.transitions = feed.call(f"{self.node}/get_available_transitions",
+                                         "lifecycle_msgs/srv/GetAvailableTransitions", {})["available_transitions"]
+        except RocError as error:
+            self.app.call_from_thread(self.query_one("#lifecycle", Static).update, f"lifecycle: {error}")
+            return
+        choices = ", ".join(t["transition"]["label"] for t in self.transitions) or "none"
+        text = f"lifecycle state: {state['label']} [{state['id']}]  (t: transition: {choices})"
+        self.app.call_from_thread(self.query_one("#lifecycle", Static).update, Text(text, style="bold"))
+
+    def action_transition(self) -> None:
+        if not self.managed:
+            self.notify(f"{self.node} is not a managed node", severity="warning")
+            return
+        labels = [t["transition"]["label"] for t in self.transitions]
+
+        def done(text: str | None) -> None:
+            chosen = next((t["transition"] for t in self.transitions if text and text.strip() in
+                           (t["transition"]["label"], str(t["transition"]["id"]))), None)
+            if chosen is not None:
+                self.change_state(chosen)
+            elif text:
+                self.notify(f"unknown transition '{text}'; available: {', '.join(labels)}", severity="error")
+        self.app.push_screen(Prompt(f"transition of {self.node} ({', '.join(labels) or 'none available'})",
+                                    labels[0] if labels else ""), done)
+
+    @work(thread=True, group="node-write")
+    def change_state(self, transition: dict[str, Any]) -> None:
+        try:
+            done = host(self).feed.call(f"{self.node}/change_state", "lifecycle_msgs/srv/ChangeState",
+                                        {"transition": transition})["success"]
+        except RocError as error:
+            self.app.call_from_thread(self.notify, f"transition failed: {error}", severity="error")
+            return
+        if done:
+            self.app.call_from_thread(self.notify, f"{transition['label']}: transitioning successful")
+        else:
+            self.app.call_from_thread(self.notify, f"{transition['label']}: transitioning failed", severity="error")
+        self.load_lifecycle()
+
+    def action_logs(self) -> None:
+        from roc.tui.logs_screen import LogsScreen
+
+        self.app.push_screen(LogsScreen(node=self.node))
 
     def on_data_table_row_selected(self, event: DataTable.RowSelected) -> None:
         key = event.row_key.value or ""

@@ -19,7 +19,8 @@ from textual.worker import get_current_worker
 from roc.cli.options import DEFAULT_TRUNCATE_LENGTH
 from roc.errors import RocError
 from roc.ros.rates import Sample, Window
-from roc.tui.model import TOPIC_WINDOW, Row, bandwidth_text, diagnoses, endpoint_cells, rate_text, shown_endpoints
+from roc.tui.model import TOPIC_WINDOW, Row, bandwidth_text, endpoint_cells, rate_text, shown_endpoints
+from roc.tui.problems import topic_diagnoses
 from roc.tui.widgets import ListTable, Prompt, host
 
 ECHO_SECONDS = 0.25  # the echo pane shows the latest message at most this often
@@ -44,6 +45,8 @@ class TopicScreen(Screen):
         Binding("escape", "app.pop_screen", "back"),
         Binding("p,space", "pause", "pause/resume echo"),
         Binding("f", "field", "field"),
+        Binding("g", "plot", "plot a numeric field"),
+        Binding("u", "publish", "publish on the topic"),
     ]
     DEFAULT_CSS = """
     TopicScreen #title { height: 1; background: $primary; }
@@ -97,8 +100,8 @@ class TopicScreen(Screen):
         info = {**info, **shown_endpoints(info)}
         rows = [Row(endpoint["gid"], endpoint_cells(endpoint)) for endpoint in info["publishers"] + info["subscribers"]]
         self.query_one("#endpoints", ListTable).show(rows)
-        problems = diagnoses({**info, "publishers": len(info["publishers"]), "subscribers": len(info["subscribers"]),
-                              "endpoints": info})
+        problems = topic_diagnoses({**info, "publishers": len(info["publishers"]),
+                                    "subscribers": len(info["subscribers"]), "endpoints": info})
         self.query_one("#problems", Static).update(Text("\n".join(f"! {p}" for p in problems)))
         self.type_name = self.type_name or (info["types"][0] if info["types"] else None)
         self.query_one("#title", Static).update(Text(f"topic {self.topic}  {', '.join(info['types'])}", style="bold"))
@@ -165,3 +168,21 @@ class TopicScreen(Screen):
                 self.draw_echo(force=True)
         self.app.push_screen(Prompt("field to show, sub-fields separated by '.' (empty: the whole message)",
                                     self.field), done)
+
+    def action_plot(self) -> None:
+        """Plot the field shown (when it is a number) or one typed, the latest message's first number
+        offered."""
+        from roc.tui.plotting import numeric_paths
+
+        value = self.shown["value"] if self.shown else None
+        paths = numeric_paths(value) if isinstance(value, dict) else []
+        offered = self.field if self.field in paths else paths[0] if paths else self.field
+
+        def done(text: str | None) -> None:
+            if text and text.strip():
+                host(self).open("plot", f"{self.topic} {text.strip()}")
+        choices = f" (numbers: {', '.join(paths[:6])}{', ...' if len(paths) > 6 else ''})" if paths else ""
+        self.app.push_screen(Prompt(f"field(s) of {self.topic} to plot, separated by spaces{choices}", offered), done)
+
+    def action_publish(self) -> None:
+        host(self).open("publish", self.topic)

@@ -15,7 +15,8 @@ from textual.widgets import DataTable, Input, Static, TextArea
 from textual.widgets.data_table import ColumnKey
 
 from roc.tui.feed import Feed
-from roc.tui.model import NO_PUBLISHER, NO_SUBSCRIBER, Row, matches
+from roc.tui.model import Row, matches
+from roc.tui.problems import NO_PUBLISHER
 
 
 class Host(Protocol):
@@ -34,11 +35,11 @@ def host(widget) -> Host:
     return cast(Host, widget.app)
 
 
-WARNINGS = (NO_PUBLISHER, NO_SUBSCRIBER, "duplicate name")
+WARNINGS = (NO_PUBLISHER, "duplicate name", "warning")
 
 
 def severity(problems: list[str]) -> str:
-    """``error`` (QoS or type problems), ``warning`` (nobody publishes or listens) or ``""``."""
+    """``error`` (QoS or type problems, a node gone), ``warning`` (nobody publishes, a name used twice) or ``""``."""
     if any(p not in WARNINGS for p in problems):
         return "error"
     return "warning" if problems else ""
@@ -127,6 +128,11 @@ class ListTable(DataTable):
         if not self._shown or self.cursor_row < 0 or self.cursor_row >= len(self._shown):
             return None
         return self._shown[self.cursor_row]
+
+    def select(self, key: str) -> None:
+        """The cursor to the row of ``key`` (if shown)."""
+        if key in self._shown:
+            self.move_cursor(row=self._shown.index(key), animate=False)
 
     def selected(self) -> Row | None:
         key = self.selected_key()

@@ -1,0 +1,94 @@
+"""The ``roc launch`` runs of this host (roc.launch.status): each process with its run, pid, state,
+restarts and last line of output, refreshed every second; Enter shows a process's output as the logs
+view shows /rosout; ``s`` stops a process, ``R`` restarts it (a process of a roc.toml system)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rich.text import Text
+from textual import work
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.screen import Screen
+from textual.widgets import DataTable, Footer, Static
+
+from roc.errors import RocError
+from roc.tui.model import Row
+from roc.tui.widgets import ListTable
+
+PROBLEM_STATES = {"failed": ["error"], "waiting": ["warning"]}
+
+
+class LaunchScreen(Screen):
+    BINDINGS = [
+        Binding("escape", "app.pop_screen", "back"),
+        Binding("s", "control('stop')", "stop the process"),
+        Binding("R", "control('restart')", "restart the process"),
+    ]
+    DEFAULT_CSS = """
+    LaunchScreen #title { height: 1; background: $primary; }
+    LaunchScreen ListTable { height: 1fr; }
+    """
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.runs: dict[str, Any] = {}  # row key -> the roc.launch.status.RunStatus of its run
+
+    def compose(self) -> ComposeResult:
+        yield Static(Text("roc launch runs on this host: looking...", style="bold"), id="title")
+        yield ListTable(("process", "run", "pid", "state", "restarts", "last line"), marks=True, id="processes")
+        yield Footer()
+
+    def on_mount(self) -> None:
+        self.query_one("#processes").focus()
+        self.poll()
+        self.set_interval(1.0, self.poll)
+
+    @work(thread=True, exclusive=True, group="launch")
+    def poll(self) -> None:
+        from roc.launch.status import runs
+
+        found = runs()
+        rows, owners = [], {}
+        for status, answer in found:
+            for process in answer["processes"]:
+                key = f"{answer['pid']}:{process['name']}"
+                owners[key] = status
+                state = process["state"] + (f" ({process['detail']})" if process["detail"] else "")
+                rows.append(Row(key, (process["name"], f"{answer['title']} [{answer['pid']}]",
+                                      str(process["pid"] or "-"), state, str(process["restarts"]),
+                                      process["last_line"]), PROBLEM_STATES.get(process["state"], [])))
+        self.runs = owners
+        title = (f"roc launch runs on this host: {len(found)}  (Enter: output, s: stop, R: restart)" if found
+                 else "no roc launch runs on this host (for this user)")
+        self.app.call_from_thread(self.show, rows, title)
+
+    def show(self, rows: list[Row], title: str) -> None:
+        self.query_one("#title", Static).update(Text(title, style="bold"))
+        self.query_one("#processes", ListTable).show(rows)
+
+    def selected(self) -> tuple[Any, str] | None:
+        key = self.query_one("#processes", ListTable).selected_key()
+        if key is None or key not in self.runs:
+            return None
+        return self.runs[key], key.split(":", 1)[1]
+
+    def on_data_table_row_selected(self, _event: DataTable.RowSelected) -> None:
+        from roc.tui.logs_screen import LogsScreen
+
+        chosen = self.selected()
+        if chosen is not None:
+            self.app.push_screen(LogsScreen(process=chosen[1], launch=chosen[0]))
+
+    def action_control(self, method: str) -> None:
+        chosen = self.selected()
+        if chosen is None:
+            return
+        status, process = chosen
+        try:
+            status.request(method, process=process)
+        except (RocError, OSError) as error:
+            self.notify(f"{method} {process}: {error}", severity="error")
+            return
+        self.notify(f"{method} {process}: asked")

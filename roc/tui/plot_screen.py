@@ -1,0 +1,158 @@
+"""A plot: numeric fields of one or more topics against time (textual-plotext, on plotext), live. The
+daemon sends only the fields asked for (its ``values`` stream with ``fields``), so a 1 kHz topic is a
+few batches of numbers a second; the screen draws at most DRAW_SECONDS apart, two points per column.
+Space pauses the view, ``+``/``-`` zoom the time window, ``a`` adds a field, ``r`` removes the last,
+``s`` writes the samples to a CSV file."""
+
+from __future__ import annotations
+
+from functools import partial
+from pathlib import Path
+
+from rich.text import Text
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.screen import Screen
+from textual.widgets import Footer, Static
+from textual.worker import get_current_worker
+from textual_plotext import PlotextPlot
+
+from roc.errors import RocError
+from roc.fsutil import write_text_atomic
+from roc.tui.plotting import Series, csv_text, thinned
+from roc.tui.widgets import Prompt, host
+
+DRAW_SECONDS = 0.5
+WINDOWS = (1, 2, 5, 10, 30, 60, 120, 300, 600)  # seconds shown, ``+``/``-`` go through them
+NS = 1e-9
+
+
+class PlotScreen(Screen):
+    BINDINGS = [
+        Binding("escape", "app.pop_screen", "back"),
+        Binding("space", "pause", "pause/resume the plot"),
+        Binding("plus,equals_sign", "zoom(-1)", "zoom in (a shorter window)"),
+        Binding("minus", "zoom(1)", "zoom out (a longer window)"),
+        Binding("a", "add", "add a field (TOPIC FIELD, or FIELD of the last topic)"),
+        Binding("r", "remove", "remove the last field"),
+        Binding("s", "save", "save the samples as CSV"),
+    ]
+    DEFAULT_CSS = """
+    PlotScreen #title { height: 1; background: $primary; }
+    PlotScreen PlotextPlot { height: 1fr; }
+    """
+
+    def __init__(self, fields: list[tuple[str, str]]) -> None:
+        """``fields``: (topic, dotted field path) pairs."""
+        super().__init__()
+        self.series = [Series(topic, path) for topic, path in fields]
+        self.window = 10
+        self.paused_at: float | None = None  # the latest time shown while paused
+        self.latest = 0.0  # the newest sample's time
+        self.received = self.lost = 0
+        self.errors: dict[str, str] = {}
+
+    def compose(self) -> ComposeResult:
+        yield Static("", id="title")
+        yield PlotextPlot(id="plot")
+        yield Footer()
+
+    def on_mount(self) -> None:
+        for topic in self.topics():
+            self.subscribe(topic)
+        self.set_interval(DRAW_SECONDS, self.draw)
+        self.draw()
+
+    def topics(self) -> list[str]:
+        return list(dict.fromkeys(one.topic for one in self.series))
+
+    def subscribe(self, topic: str) -> None:
+        """(Re)start the stream of ``topic`` with every field of it plotted."""
+        paths = [one.path for one in self.series if one.topic == topic]
+        self.run_worker(partial(self.read, topic, paths), thread=True, exclusive=True, group=f"plot {topic}")
+
+    def read(self, topic: str, paths: list[str]) -> None:
+        worker = get_current_worker()
+        if not paths:
+            return
+        try:
+            params = {"topic": topic, "fields": paths}
+            for event in host(self).feed.stream("values", params, lambda: worker.is_cancelled):
+                if event["event"] == "samples":
+                    self.app.call_from_thread(self.take, topic, event)
+        except RocError as error:
+            self.errors[topic] = str(error)
+
+    def take(self, topic: str, event: dict) -> None:
+        times = [t * NS for t in event["time"]]
+        for one in self.series:
+            if one.topic == topic and one.path in event["values"]:
+                one.add(times, event["values"][one.path])
+        self.received += len(times)
+        self.lost += event.get("lost", 0)
+        if times:
+            self.latest = max(self.latest, times[-1])
+
+    def draw(self) -> None:
+        end = self.paused_at if self.paused_at is not None else self.latest
+        start = end - self.window
+        state = "paused (Space: resume)" if self.paused_at is not None else "live (Space: pause)"
+        errors = "  ".join(f"{topic}: {error}" for topic, error in self.errors.items())
+        self.query_one("#title", Static).update(Text(
+            f"plot, last {self.window} s, {state}  {self.received} samples, {self.lost} lost  {errors}", style="bold"))
+        widget = self.query_one(PlotextPlot)
+        plt = widget.plt
+        plt.clear_data()
+        plt.clear_figure()
+        columns = max(10, widget.size.width - 12)
+        for one in self.series:
+            times, values = thinned(*one.window(start, end), columns)
+            if times:
+                plt.plot([t - end for t in times], values, label=one.label, marker="braille")
+        plt.xlim(-self.window, 0)
+        plt.xlabel("seconds")
+        widget.refresh()
+
+    def action_pause(self) -> None:
+        self.paused_at = None if self.paused_at is not None else self.latest
+        self.draw()
+
+    def action_zoom(self, step: int) -> None:
+        index = WINDOWS.index(self.window) if self.window in WINDOWS else 3
+        self.window = WINDOWS[max(0, min(len(WINDOWS) - 1, index + step))]
+        self.draw()
+
+    def action_add(self) -> None:
+        last = self.series[-1].topic if self.series else ""
+
+        def done(text: str | None) -> None:
+            words = (text or "").split()
+            if not words:
+                return
+            topic, path = (words[0], words[1]) if len(words) > 1 else (last, words[0])
+            if not topic:
+                self.notify("name the topic too: TOPIC FIELD", severity="warning")
+                return
+            self.series.append(Series(topic, path))
+            self.subscribe(topic)
+        self.app.push_screen(Prompt(f"field to plot: TOPIC FIELD, or FIELD of {last or 'a topic'}", ""), done)
+
+    def action_remove(self) -> None:
+        if self.series:
+            removed = self.series.pop()
+            self.subscribe(removed.topic)
+            self.draw()
+
+    def action_save(self) -> None:
+        def done(path: str | None) -> None:
+            if path:
+                self.save(Path(path).expanduser())
+        self.app.push_screen(Prompt("write the samples kept to the CSV file", "plot.csv"), done)
+
+    def save(self, path: Path) -> None:
+        try:
+            write_text_atomic(path, csv_text(self.series))
+        except OSError as error:
+            self.notify(f"cannot write {path}: {error.strerror}", severity="error")
+            return
+        self.notify(f"wrote {path}")
