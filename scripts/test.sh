@@ -12,7 +12,7 @@ bash "$ROOT/scripts/setup.sh"
 rc=0
 # loadgroup: tests marked xdist_group("busy_or_timing") share one worker, so the bridge tests' busy
 # processes never run beside the daemon-less discovery test (which timing under load can fail)
-# the whole of tests/, unless ARGS name test files or directories (tests/test_x.py::test_y included)
+# the whole of tests/, unless ARGS name test files or directories (tests/bag/test_bag_files.py::test_y included)
 paths=(tests)
 for arg in "$@"; do
     if [ -e "${arg%%::*}" ]; then paths=(); fi

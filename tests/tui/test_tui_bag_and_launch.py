@@ -9,11 +9,11 @@ import asyncio
 import subprocess
 
 import pytest
-from build_helpers import BIN
-from graph_helpers import read_line, stop_all
-from launch_helpers import demo_env, roc_launch
-from oracles import SHARED
-from tui_helpers import live_graph, picture, screen_name, table, until
+from helpers.build import BIN
+from helpers.graph import read_line, stop_all
+from helpers.launch import demo_env, roc_launch
+from helpers.oracles import SHARED
+from helpers.tui import live_graph, picture, screen_name, table, until
 
 from roc.tui.app import RocApp
 
@@ -35,7 +35,7 @@ executable = "listener"
 def test_a_bag_opened_stepped_through_and_played_on_the_graph(tmp_path) -> None:
     if not TALKER_BAG.is_dir():
         pytest.fail(f"rosbag2's reference bags are missing at {TALKER_BAG}")
-    from graph_helpers import graph_env
+    from helpers.graph import graph_env
 
     with live_graph(graph_env(45, tmp_path / "runtime"), []) as env:
         (tmp_path / "runtime").mkdir(exist_ok=True)

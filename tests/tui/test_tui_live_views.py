@@ -14,9 +14,9 @@ import time
 
 import psutil
 import pytest
-from build_helpers import BIN
-from graph_helpers import graph_env, read_line, roc, start_nodes, stop_all
-from tui_helpers import (
+from helpers.build import BIN
+from helpers.graph import graph_env, read_line, roc, start_nodes, stop_all
+from helpers.tui import (
     GRAPH,
     live_graph,
     picture,

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 import yaml
 from helpers.graph import DEMO_GRAPH, graph_env, roc
-from helpers.tui import SIZE, live_graph, open_row, table, until
+from helpers.tui import SIZE, live_graph, open_row, table, text_of, until
 
 from roc.tui.app import RocApp
 
@@ -47,10 +47,6 @@ def loads_no_rclpy_when_asked():
     if os.environ.get("ROC_TUI_ASSERT_NO_RCLPY") == "1":
         loaded = sorted(name for name in sys.modules if name.split(".")[0] == "rclpy")
         assert not loaded, f"roc tui loaded rclpy: {loaded[:5]}"
-
-
-def text_of(app, selector: str) -> str:
-    return str(app.screen.query_one(selector).render())
 
 
 def drive(test) -> None:
