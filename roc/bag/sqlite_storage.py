@@ -51,16 +51,41 @@ def _in_wal_mode(path: Path) -> bool:
     return len(header) == 20 and header[18] == header[19] == WAL_MODE
 
 
+def _in_use(index: Path) -> bool:
+    """Whether a connection holds a ``-shm`` index open: sqlite's connections keep a read lock on its
+    byte 128 (the "DMS" byte) while they have it, so a recording still writing holds one."""
+    import fcntl
+    import os
+    import struct
+
+    try:
+        descriptor = os.open(index, os.O_RDONLY)
+    except OSError:
+        return False
+    try:
+        flock = "hhqqi4x"  # struct flock: type, whence, start, length, pid
+        answer = fcntl.fcntl(descriptor, fcntl.F_GETLK, struct.pack(flock, fcntl.F_WRLCK, 0, 128, 1, 0))
+        return struct.unpack(flock, answer)[0] != fcntl.F_UNLCK
+    except OSError:
+        return True
+    finally:
+        os.close(descriptor)
+
+
 def read_only_uri(path: Path) -> tuple[str, bool]:
     """The URI that opens ``path`` for reading without writing beside it, and whether the connection
     must then ask for exclusive locking. A file in rollback-journal mode opens read-only (``mode=ro``).
-    A file in write-ahead-log mode whose ``-shm`` index exists (a recording may still be writing it)
-    shares that index with its writer. Without one, its log (a killed recording's last commits, if
-    any) is read with the index in this process's memory: exclusive locking before the first read
-    (sqlite then creates no ``-shm``), and no file locks (``unix-none``) since no writer is left."""
+    A file in write-ahead-log mode that a recording is still writing shares its ``-shm`` index with
+    it. Otherwise, without a log (or an empty one) the file alone holds everything and is read as
+    ``immutable``; with one (a killed recording's last commits), the log is read with its index in
+    this process's memory: exclusive locking before the first read (sqlite then neither creates a
+    ``-shm`` nor writes one left behind), and no file locks (``unix-none``), since no writer is left."""
     base = "file:" + urllib.parse.quote(str(path.absolute())) + "?mode=ro"
-    if not _in_wal_mode(path) or path.with_name(path.name + "-shm").exists():
+    if not _in_wal_mode(path) or _in_use(path.with_name(path.name + "-shm")):
         return base, False
+    log = path.with_name(path.name + "-wal")
+    if not log.exists() or log.stat().st_size == 0:
+        return base + "&immutable=1", False
     return base + "&vfs=unix-none", True
 
 
