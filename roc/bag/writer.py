@@ -125,6 +125,7 @@ class BagWriter:
         self._file: McapWriter | SqliteWriter | None = None
         self._file_start = self._file_end = self._file_count = 0
         self._latest: dict[str, deque[tuple[bytes, int, int]]] = {}  # of repeated topics, uncompressed
+        self.repeated = 0  # messages written again at the start of a file
         self._compress = (compression.MessageCompressor() if options.compression_mode == "message" else None)
         self.closed = False
         self.failed = False  # a write failed: what the files hold may be less than what was written
@@ -175,6 +176,7 @@ class BagWriter:
                            for kept_data, kept_time, _ in latest), key=lambda item: item[0])
             for _, name, kept_data in kept:
                 self._put(name, kept_data, log_time, log_time)
+            self.repeated += len(kept)
         self._put(topic, data, log_time, publish_time)
         self.remember(topic, data, log_time, publish_time)
 

@@ -62,6 +62,7 @@ class Result:
     paused_dropped: int
     before_clock_dropped: int
     error: str | None = None
+    repeated: int = 0  # transient local messages written again at the start of split files
 
 
 def _clock_ns(data: bytes) -> int | None:
@@ -204,4 +205,5 @@ class Recorder:
                 error = error or str(full)
                 metadata = writer.metadata()
             graph.close()
-        return Result(metadata, self._subscribed, self._paused_dropped, self._before_clock_dropped, error)
+        return Result(metadata, self._subscribed, self._paused_dropped, self._before_clock_dropped, error,
+                      writer.repeated)

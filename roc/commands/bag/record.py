@@ -127,6 +127,8 @@ def _summary(result, uri: str) -> list[str]:
                              header=["topic", "received", "written", "lost"])
     lost = sum(s.lost for s in result.stats.values())
     lines.append(f"Lost messages: {lost} (gaps in the publishers' sequence numbers)")
+    if result.repeated:
+        lines.append(f"Repeated at the start of split files: {result.repeated} (--repeat-transient-local)")
     if result.paused_dropped:
         lines.append(f"Not written while paused: {result.paused_dropped}")
     if result.before_clock_dropped:
