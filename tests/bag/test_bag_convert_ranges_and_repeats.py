@@ -137,3 +137,22 @@ def test_a_bad_range_is_one_line_naming_the_file_and_topic(source, tmp_path, ran
     assert result.stderr == (f"roc: error: {tmp_path / 'out.yaml'}: output_bags[0]: {error} "
                              "(see 'roc bag convert --help')\n")
     assert not (tmp_path / "bad").exists()
+
+
+@pytest.mark.parametrize(("given", "error"), [
+    (["/tf_static=0"], "--repeat-transient-local: '/tf_static=0' is not TOPIC or TOPIC=DEPTH (a positive number)"),
+    (["/map=x"], "--repeat-transient-local: '/map=x' is not TOPIC or TOPIC=DEPTH (a positive number)"),
+])
+def test_record_refuses_a_bad_repeat_before_joining_the_graph(tmp_path, given, error):
+    result = subprocess.run([str(BIN / "roc"), "bag", "record", "/tf", "-o", str(tmp_path / "bag"),
+                             "--repeat-transient-local", *given], capture_output=True, text=True, timeout=60)
+    assert (result.returncode, result.stderr) == (2, f"roc: error: {error} (see 'roc bag record --help')\n")
+    assert not (tmp_path / "bag").exists()
+
+
+def test_record_options_name_topics_and_depths():
+    from roc.commands.bag.record import repeat_options
+
+    assert repeat_options(None, 0) == ({}, 0)
+    assert repeat_options([], 0) == ({}, 1)  # the option alone: every transient local topic
+    assert repeat_options(["tf_static", "/map=3"], 2) == ({"/tf_static": 1, "/map": 3}, 2)
