@@ -140,18 +140,18 @@ class _Parser:
         return found[1]
 
     def condition(self) -> Any:
-        operands = [self.conjunction()]
-        while self.peek() == ("keyword", "OR"):
-            self.at += 1
-            operands.append(self.conjunction())
-        return operands[0] if len(operands) == 1 else Logical("OR", tuple(operands))
+        return self._joined("OR", self.conjunction)
 
     def conjunction(self) -> Any:
-        operands = [self.negation()]
-        while self.peek() == ("keyword", "AND"):
+        return self._joined("AND", self.negation)
+
+    def _joined(self, op: str, operand: Any) -> Any:
+        """``operand (op operand)*``: one operand alone, or their Logical."""
+        operands = [operand()]
+        while self.peek() == ("keyword", op):
             self.at += 1
-            operands.append(self.negation())
-        return operands[0] if len(operands) == 1 else Logical("AND", tuple(operands))
+            operands.append(operand())
+        return operands[0] if len(operands) == 1 else Logical(op, tuple(operands))
 
     def negation(self) -> Any:
         if self.peek() == ("keyword", "NOT"):
