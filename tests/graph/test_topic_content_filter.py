@@ -179,9 +179,13 @@ def test_the_publisher_sends_only_what_passes(numbers, tmp_path):
     runs = json.loads(result.stdout)
     print({name: (round(run["wire_bytes_per_second"]), round(run["bw"]["bytes_per_second"]))
            for name, run in runs.items()})
-    unfiltered, middleware, own = (runs[name]["wire_bytes_per_second"] for name in ("unfiltered", "middleware", "roc"))
-    assert runs["unfiltered"]["bw"]["bytes_per_second"] == pytest.approx(200_000, rel=0.15)
-    for name in ("middleware", "roc"):  # what reaches roc topic bw: the tenth that passes
-        assert runs[name]["bw"]["bytes_per_second"] == pytest.approx(20_000, rel=0.2)
-    assert unfiltered > 180_000 and own > 0.8 * unfiltered
-    assert middleware < 0.2 * unfiltered
+    wire = {name: run["wire_bytes_per_second"] for name, run in runs.items()}
+    delivered = {name: run["bw"]["bytes_per_second"] for name, run in runs.items()}
+    # what reaches roc topic bw: every message unfiltered, the tenth that passes with either filter
+    # (ratios: a loaded machine publishes less than 100 Hz, each run at its own pace)
+    assert delivered["middleware"] == pytest.approx(delivered["unfiltered"] / 10, rel=0.35)
+    assert delivered["roc"] == pytest.approx(delivered["unfiltered"] / 10, rel=0.35)
+    # what crosses the wire: what is delivered, plus the protocol's own, unless roc filters
+    assert wire["unfiltered"] < 1.5 * delivered["unfiltered"]
+    assert wire["middleware"] < 2 * delivered["middleware"]
+    assert wire["roc"] > 5 * delivered["roc"]
