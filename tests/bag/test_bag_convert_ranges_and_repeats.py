@@ -76,6 +76,7 @@ def each_file(bag: Path) -> list[list[tuple[str, int, str]]]:
     return files
 
 
+@pytest.mark.slow
 def test_each_split_file_begins_with_the_latest_transient_local_message(source, tmp_path):
     result = convert(source, tmp_path, {"uri": "split", "all_topics": True, "max_bagfile_duration": 1,
                                         "repeat_transient_local_messages": {"/tf_static": 1}},
@@ -131,28 +132,43 @@ def test_per_topic_message_and_time_ranges(source, tmp_path):
     ({"repeat_transient_local_messages": {"/tf_static": 0}},
      "repeat_transient_local_messages: /tf_static: expected a positive integer, got 0"),
 ])
-def test_a_bad_range_is_one_line_naming_the_file_and_topic(source, tmp_path, ranges, error):
-    result = convert(source, tmp_path, {"uri": "bad", "all_topics": True, **ranges})
-    assert result.returncode == 2
-    assert result.stderr == (f"roc: error: {tmp_path / 'out.yaml'}: output_bags[0]: {error} "
-                             "(see 'roc bag convert --help')\n")
+def test_a_bad_range_names_the_file_output_and_topic(source, tmp_path, ranges, error):
+    from roc.bag.convert import convert as convert_bags
+    from roc.bag.convert import read_output_options
+    from roc.errors import UsageError
+
+    options = tmp_path / "out.yaml"
+    options.write_text(yaml.safe_dump({"output_bags": [{"uri": str(tmp_path / "bad"), "all_topics": True, **ranges}]}))
+    with pytest.raises(UsageError) as raised:
+        convert_bags([(str(source), None)], read_output_options(options))
+    assert str(raised.value) == f"{options}: output_bags[0]: {error}"
     assert not (tmp_path / "bad").exists()
 
 
-@pytest.mark.parametrize(("given", "error"), [
-    (["/tf_static=0"], "--repeat-transient-local: '/tf_static=0' is not TOPIC or TOPIC=DEPTH (a positive number)"),
-    (["/map=x"], "--repeat-transient-local: '/map=x' is not TOPIC or TOPIC=DEPTH (a positive number)"),
-])
-def test_record_refuses_a_bad_repeat_before_joining_the_graph(tmp_path, given, error):
+def test_a_bad_range_is_one_line_and_writes_nothing(source, tmp_path):
+    result = convert(source, tmp_path, {"uri": "bad", "all_topics": True, "topic_message_ranges": {"/data": [5, 4]}})
+    assert (result.returncode, result.stdout) == (2, "")
+    assert result.stderr == (f"roc: error: {tmp_path / 'out.yaml'}: output_bags[0]: topic_message_ranges: /data: "
+                             "the first (5) is after the last (4) (see 'roc bag convert --help')\n")
+    assert not (tmp_path / "bad").exists()
+
+
+def test_record_refuses_a_bad_repeat_before_joining_the_graph(tmp_path):
     result = subprocess.run([str(BIN / "roc"), "bag", "record", "/tf", "-o", str(tmp_path / "bag"),
-                             "--repeat-transient-local", *given], capture_output=True, text=True, timeout=60)
-    assert (result.returncode, result.stderr) == (2, f"roc: error: {error} (see 'roc bag record --help')\n")
+                             "--repeat-transient-local", "/tf_static=0"], capture_output=True, text=True, timeout=60)
+    assert (result.returncode, result.stderr) == (2, "roc: error: --repeat-transient-local: '/tf_static=0' is not "
+                                                     "TOPIC or TOPIC=DEPTH (a positive number) (see 'roc bag record "
+                                                     "--help')\n")
     assert not (tmp_path / "bag").exists()
 
 
 def test_record_options_name_topics_and_depths():
     from roc.commands.bag.record import repeat_options
+    from roc.errors import UsageError
 
     assert repeat_options(None, 0) == ({}, 0)
     assert repeat_options([], 0) == ({}, 1)  # the option alone: every transient local topic
     assert repeat_options(["tf_static", "/map=3"], 2) == ({"/tf_static": 1, "/map": 3}, 2)
+    for bad in ("/map=x", "=2", "/map=-1"):
+        with pytest.raises(UsageError, match=f"'{bad}' is not TOPIC or TOPIC=DEPTH"):
+            repeat_options([bad], 0)
