@@ -2,10 +2,12 @@
 using the real launch library; imported only in the runner's process, like runner.py itself.
 
 - ``explain``: the launch runs as ``ros2 launch`` would run it (arguments, substitutions, conditions,
-  includes, groups, timers, ``SetEnvironmentVariable``, launch_ros's parameter files and remappings), except
-  that each process action stops where it would start its process (``ExecuteLocal.execute`` records the
-  prepared command line, working directory and environment and returns) and composable nodes are recorded,
-  not loaded. What starts only on a process's events (``OnProcessStart``, ``OnProcessExit``) is not seen.
+  includes, groups, ``SetEnvironmentVariable``, launch_ros's parameter files and remappings), except that
+  each process action stops where it would start its process (``ExecuteLocal.execute`` records the
+  prepared command line, working directory and environment and returns), composable nodes are recorded,
+  not loaded, a lifecycle node is not monitored, and timers fire a thousand times sooner (in the same
+  order). Nothing joins the ROS graph. What starts only on a process's events (``OnProcessStart``,
+  ``OnProcessExit``) is not seen.
 - ``arguments``: the launch arguments of the file and of every file it includes, recursively, each with the
   file that declares it; include paths are evaluated with the arguments' values known so far (the
   command line's, then the defaults), which ros2 launch's ``--show-args`` does not do.
@@ -51,6 +53,33 @@ def _loads(action, context) -> list[dict[str, Any]]:
     return loads
 
 
+TIME_SCALE = 1e-3  # --explain's timers: a thousand times faster, in the same order
+
+
+def _quick_timers() -> None:
+    """TimerAction (and launch_ros's RosTimer, which would need the launch's ROS node) fire after a
+    thousandth of their period: what they start is seen at once, in the order a start would see it."""
+    import asyncio
+
+    from launch.actions import TimerAction
+    from launch.events import TimerEvent
+    from launch.utilities.type_utils import perform_typed_substitution
+
+    async def wait_to_fire_event(action, context) -> None:
+        await asyncio.sleep(perform_typed_substitution(context, action.period, float) * TIME_SCALE)
+        if not action._canceled_future.done():
+            await context.emit_event(TimerEvent(timer_action=action))
+        action._completed_future.set_result(None)
+
+    TimerAction._wait_to_fire_event = wait_to_fire_event
+    try:
+        from launch_ros.actions import RosTimer
+
+        RosTimer._wait_to_fire_event = wait_to_fire_event  # type: ignore[method-assign]
+    except ImportError:
+        pass
+
+
 def explain(path: str, arguments: list[tuple[str, str]], debug: bool) -> tuple[int, dict[str, Any]]:
     """Every process the launch would start: name, command line, working directory, environment."""
     import launch
@@ -76,8 +105,12 @@ def explain(path: str, arguments: list[tuple[str, str]], debug: bool) -> tuple[i
         return None
 
     ExecuteLocal.execute = record
+    _quick_timers()
     try:
-        from launch_ros.actions import ComposableNodeContainer, LoadComposableNodes
+        from launch_ros.actions import ComposableNodeContainer, LifecycleNode, LoadComposableNodes, Node
+
+        # a lifecycle node's state monitoring needs the launch's own ROS node: only its process is wanted
+        LifecycleNode.execute = Node.execute  # type: ignore[method-assign]
 
         def load(action, context):
             target = action._LoadComposableNodes__target_container
@@ -144,7 +177,13 @@ def arguments(path: str, given: list[tuple[str, str]]) -> dict[str, Any]:
         try:
             description = source.get_launch_description(context)
         except Exception as error:  # noqa: BLE001 - a path known only at run time, a file that fails to load
-            unknown.append(f"{file}: cannot follow the include of {source.location}: {error}")
+            from roc.launch.files import one_line
+
+            location = getattr(source, "_LaunchDescriptionSource__location", None)
+            where = " + ".join(sub.describe() for sub in location) if location else source.location
+            path = evaluate(location) if location else None
+            where += f" ({path})" if path and path != where else ""
+            unknown.append(f"{file}: cannot follow the include of {where}: {one_line(str(error))}")
             return
         set_by = {}
         for name, value in entity.launch_arguments:
@@ -153,8 +192,18 @@ def arguments(path: str, given: list[tuple[str, str]]) -> dict[str, Any]:
                 set_by[name] = {"file": file, "value": value}
                 if value is not None:
                     context.launch_configurations[name] = value
-        walk(description.entities, source.location, [*chain, file], conditional or entity.condition is not None,
-             set_by)
+        within(source.location, lambda: walk(description.entities, source.location, [*chain, file],
+                                             conditional or entity.condition is not None, set_by))
+
+    def within(file: str, visit) -> None:
+        """``visit`` with the launch file's path known (ThisLaunchFileDir, $(dirname)), as when included."""
+        context._push_locals()
+        context.extend_locals({"current_launch_file_path": file,
+                               "current_launch_file_directory": os.path.dirname(file)})
+        try:
+            visit()
+        finally:
+            context._pop_locals()
 
     def walk(entities, file: str, chain: list[str], conditional: bool, set_by: dict[str, dict]) -> bool:
         """False after a ResetLaunchConfigurations (no later argument is the command line's to set)."""
@@ -173,5 +222,5 @@ def arguments(path: str, given: list[tuple[str, str]]) -> dict[str, Any]:
         return True
 
     top = get_launch_description_from_any_launch_file(path)
-    walk(top.entities, os.path.abspath(path), [], False, {})
+    within(os.path.abspath(path), lambda: walk(top.entities, os.path.abspath(path), [], False, {}))
     return {"file": os.path.abspath(path), "arguments": list(found.values()), "unknown": unknown}

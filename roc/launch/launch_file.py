@@ -23,6 +23,7 @@ from roc.launch.running import Running, RunOptions
 from roc.launch.warm_start import NOT_USED_SECONDS, start_server, wait_for_server
 
 SETTLE_SECONDS = 1.0  # --check starts once no process has started for this long
+CAUGHT = "Caught exception in launch (see debug for traceback)"  # the launch library's error line
 
 
 @dataclass
@@ -61,6 +62,10 @@ def evaluate(launch_file: LaunchFile, mode: str, env: dict[str, str]) -> dict:
         text = result.read()
     if done.returncode != 0 or not text:
         output = (done.stdout + done.stderr).strip()
+        if CAUGHT in output and not launch_file.debug:  # the library's error, made one line
+            from roc.launch.files import one_line
+
+            raise RocError(f"{launch_file.path}: {one_line(output.split(CAUGHT, 1)[1].removeprefix(': '))}")
         if launch_file.debug or "\n" in output:
             print(output, file=sys.stderr)
             raise RocError(f"{launch_file.path}: the launch failed while evaluated (its output is above)")

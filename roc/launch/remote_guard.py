@@ -206,6 +206,10 @@ def run(spec: dict) -> int:
     try:
         lost = watch(process)
     finally:  # lost, ended, or the guard itself told to stop (SIGTERM)
+        try:
+            os.killpg(process.pid, signal.SIGTERM)  # at once; the sweep then looks for the rest
+        except OSError:
+            pass
         sweep(spec["token"], recorded, {process.pid}, GRACE_SECONDS)
     code = process.wait()
     report("exited", code=code, reason=lost)
