@@ -14,8 +14,8 @@ the host by its install's setup.bash. The failures, each round:
 - the network cut: the relay stops carrying anything, without closing either side;
 - the launcher killed (SIGKILL): roc; for plain ssh, the shell that ran it (ssh itself lives on).
 
-For roc, one ``roc launch`` of a system with a local talker and the remote listener (``respawn = true``)
-per round goes through the failures in that order (each respawn gives the next failure a fresh process).
+For roc, one ``roc launch`` of a system with a local talker and the remote listener (``respawn = true``,
+tests/launch/remote_helpers.py) per round goes through the failures in that order (each respawn gives the next failure a fresh process).
 Each time: the seconds from the failure until the remote process is gone (read in /proc every 10 ms), or
 "still running" after ``--patience`` seconds (then the script stops it itself). Median, min and max over
 the rounds.
@@ -37,48 +37,12 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(REPO / "tests"), str(REPO / "tests" / "launch")]
 from launch_helpers import SITE, build_demo  # noqa: E402
-from ssh_server import ssh_server  # noqa: E402
+from remote_helpers import REMOTE, alive, ancestors, comm, ssh_server, sshd_session, write_pair  # noqa: E402
 
 WORK = REPO / "bench" / ".work" / "remote_ws"
 ROC = str(Path(sys.executable).parent / "roc")
 DOMAIN = "96"
-SYSTEM = """
-[launch.pair.hosts."robot"]
-setup = "{setup}"
-[[launch.pair.process]]
-package = "roc_launch_demo"
-executable = "talker"
-[[launch.pair.process]]
-package = "roc_launch_demo"
-executable = "listener"
-host = "robot"
-respawn = true
-respawn-delay = 0.2
-after = ["process talker started"]
-"""
 FAILURES = ("ssh client killed", "sshd session killed", "network cut", "launcher killed")
-REMOTE = "robot:listener"
-
-
-def alive(pid: int) -> bool:
-    try:
-        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] not in ("Z", "X")
-    except OSError:
-        return False
-
-
-def parent(pid: int) -> int:
-    return int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
-
-
-def comm(pid: int) -> str:
-    return Path(f"/proc/{pid}/comm").read_text().strip()
-
-
-def sshd_session(pid: int) -> int:
-    while comm(pid := parent(pid)) != "sshd":
-        pass
-    return pid
 
 
 def stopped_after(pid: int, patience: float) -> float | None:
@@ -110,7 +74,7 @@ def roc_round(env: dict[str, str], directory: Path, server, patience: float) -> 
     def ready(count: int) -> int:
         text = log.read_text(errors="replace")
         pids = re.findall(rf"\[INFO\] \[{REMOTE}\]: process started with pid \[(\d+)\]", text)
-        return int(pids[-1]) if len(pids) == count and text.count(f"[{REMOTE}] [INFO] [") >= count else 0
+        return int(pids[-1]) if len(pids) == count and text.count("[local.far_listener]: ready") >= count else 0
 
     import psutil
 
@@ -124,7 +88,8 @@ def roc_round(env: dict[str, str], directory: Path, server, patience: float) -> 
     times = {}
     try:
         for count, failure in enumerate(FAILURES, 1):
-            pid = wait_for(lambda n=count: ready(n), 90, f"start {count} of the remote process")
+            pid = wait_for(lambda n=count: ready(n), 90, f"start {count} of the remote process; roc's output:\n"
+                           f"{log.read_text(errors='replace')}")
             fail[failure](pid)
             times[failure] = stopped_after(pid, patience)
     finally:
@@ -147,7 +112,7 @@ def ssh_round(env: dict[str, str], server, prefix: Path, terminal: bool, patienc
         def listener() -> int:
             found = [p.pid for p in psutil.process_iter(["cmdline"])
                      if p.info["cmdline"] and p.info["cmdline"][-1].endswith("roc_launch_demo/listener")
-                     and "sshd" in {comm(a) for a in _ancestors(p.pid)}]
+                     and "sshd" in {comm(a) for a in ancestors(p.pid)}]
             return found[0] if len(found) == 1 else 0
 
         pid = wait_for(listener, 60, "the listener started by ssh")
@@ -171,17 +136,6 @@ def ssh_round(env: dict[str, str], server, prefix: Path, terminal: bool, patienc
     return times
 
 
-def _ancestors(pid: int) -> list[int]:
-    found = []
-    while pid > 1:
-        try:
-            pid = parent(pid)
-        except OSError:
-            break
-        found.append(pid)
-    return found
-
-
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rounds", type=int, default=5)
@@ -196,7 +150,7 @@ def main() -> int:
         env = {**os.environ, **server.env(), "ROS_DOMAIN_ID": DOMAIN, "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
                "AMENT_PREFIX_PATH": os.pathsep.join([str(prefix), sys.prefix]),
                "PYTHONPATH": str(prefix / SITE)}
-        (Path(scratch) / "roc.toml").write_text(SYSTEM.format(setup=prefix.parent / "setup.bash"))
+        write_pair(Path(scratch), prefix, respawn=True)
         for round_number in range(args.rounds):
             for name, measure in (("roc launch", lambda: roc_round(env, Path(scratch), server, args.patience)),
                                   ("ssh HOST CMD", lambda: ssh_round(env, server, prefix, False, args.patience)),

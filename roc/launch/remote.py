@@ -153,8 +153,8 @@ def check_hosts(system: System, env: dict[str, str]) -> dict[str, dict]:
 
     used = {spec.host for spec in system.remote()}
     tasks = [task(host) for name, host in system.hosts.items() if name in used]
-    if tasks:
-        execute(tasks, [failed], workers=0, continue_on_error=True, kind="host")
+    if tasks and execute(tasks, [failed], workers=0, continue_on_error=True, kind="host").interrupted:
+        raise KeyboardInterrupt  # Ctrl+C while checking: nothing has started
     if failures:
         raise RocError(f"{system.path}: [launch.{system.name}]: {'; '.join(failures)}")
     return found
@@ -171,14 +171,14 @@ class RemoteProcess:
         self.note, self.usage = note, usage
         self.pid = 0
         self.args: list[str] = []
-        self.cwd = ""
         self.returncode: int | None = None
         self._code: int | None = None  # the process's exit code, as the guard reported it
-        self._reason = ""
+        self._reason = ""  # why the guard stopped it, when it did on its own
         self._error = ""
         self._ssh_lines: list[str] = []
         self._started = threading.Event()
-        self._lock = threading.Lock()
+        self._lock = threading.Lock()  # writes into the session
+        self._finishing = threading.Lock()
         start = {"mode": "run", "setup": host.setup, "package": spec.package, "executable": spec.executable,
                  "arguments": [*spec.arguments, *spec.ros_arguments()], "env": remote_environment(spec),
                  "token": token}
@@ -232,9 +232,12 @@ class RemoteProcess:
                 if self.pid:
                     self.note(f"ssh: {line}")
                 continue
-            event = json.loads(line[len(MARK):])
+            try:
+                event = json.loads(line[len(MARK):])
+            except ValueError:
+                continue
             if event["event"] == "started":
-                self.pid, self.args, self.cwd = event["pid"], event["cmd"], event["cwd"]
+                self.pid, self.args = event["pid"], event["cmd"]
                 self._started.set()
             elif event["event"] == "usage":
                 self.usage(event["cpu"], event["rss"])
@@ -247,12 +250,15 @@ class RemoteProcess:
     def _finish(self) -> int:
         ssh_code = self.ssh.wait()
         self._control.join()
-        if self.returncode is None:
-            if self._code is None:
-                how = f"exit code {ssh_code}" if ssh_code >= 0 else f"killed by {signal.Signals(-ssh_code).name}"
-                self.note(f"the connection to '{self.destination}' was lost (ssh {how}): the process there is "
-                          "stopped by roc's guard on that host")
-            self.returncode = self._code if self._code is not None else SSH_FAILED
+        with self._finishing:
+            if self.returncode is None:
+                if self._code is None:
+                    how = f"exit code {ssh_code}" if ssh_code >= 0 else f"killed by {signal.Signals(-ssh_code).name}"
+                    self.note(f"the connection to '{self.destination}' was lost (ssh {how}): the process there is "
+                              "stopped by roc's guard on that host")
+                elif self._reason:
+                    self.note(f"roc's guard on '{self.destination}' stopped the process: {self._reason}")
+                self.returncode = self._code if self._code is not None else SSH_FAILED
         return self.returncode
 
     def poll(self) -> int | None:

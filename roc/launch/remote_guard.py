@@ -14,9 +14,10 @@ settings, its output going straight into the SSH session. Then it stays tied to 
   (guard.sweep: SIGTERM, then SIGKILL after GRACE_SECONDS). So a remote process outlives a failure
   by at most SILENCE_SECONDS + GRACE_SECONDS.
 
-What it tells roc goes to its standard error as lines ``roc-remote JSON``: ``started`` (pid, command line,
-working directory), ``usage`` (CPU and memory, each second), ``exited`` (the exit code, negative for a
-signal, as subprocess reports it), ``error`` (nothing started), or for ``mode: check`` one ``checked``.
+What it tells roc goes to its standard error as lines ``roc-remote JSON``: ``started`` (pid, command line),
+``usage`` (CPU and memory, each second), ``exited`` (the exit code, negative for a signal, as subprocess
+reports it, and why the guard stopped it, if it did), ``error`` (nothing started), or for ``mode: check``
+one ``checked`` (the executables' paths, what is missing, the working directory there).
 """
 
 from __future__ import annotations
@@ -200,7 +201,7 @@ def run(spec: dict) -> int:
     except OSError as failure:
         report("error", message=f"cannot run '{path}': {failure.strerror}")
         return 2
-    report("started", pid=process.pid, cmd=command, cwd=os.getcwd())
+    report("started", pid=process.pid, cmd=command)
     recorded = {process.pid: start_time(process.pid) or 0}
     lost = ""
     try:

@@ -12,7 +12,7 @@ import re
 from pathlib import Path
 
 import pytest
-from explain_helpers import as_proc_shows
+from explain_helpers import as_proc_shows, proc_argv, proc_environ
 from graph_helpers import install_oracle, roc, ros2, stop_daemon
 from launch_helpers import (
     demo_env,
@@ -91,18 +91,8 @@ def _started(output: str) -> dict[str, int]:
                                                        output)}
 
 
-def _argv(pid: int) -> list[str]:
-    """A process's command line from /proc, as psutil reads it: a process forked by roc's warm start shows
-    it as one title (words joined by spaces, as setproctitle writes it), an exec'd one word by word."""
-    raw = Path(f"/proc/{pid}/cmdline").read_bytes()
-    if raw.count(b"\0") == 1 and raw.endswith(b"\0"):
-        return raw[:-1].decode().split(" ")
-    return raw.decode().split("\0")[:-1]
 
 
-def _environ(pid: int) -> dict[str, str]:
-    entries = Path(f"/proc/{pid}/environ").read_bytes().decode().split("\0")
-    return dict(entry.split("=", 1) for entry in entries if "=" in entry)
 
 
 def _yaml(path: str):
@@ -136,12 +126,12 @@ def test_explain_lists_exactly_what_a_start_then_runs(demo, tmp_path: Path) -> N
         launcher.wait_for_output("[sleeper-5]: process started with pid", timeout=60)
         started = _started(launcher.output())
         assert sorted(started) == sorted(entries)
-        roc_environ = _environ(launcher.pid)
+        roc_environ = proc_environ(launcher.pid)
         for name, entry in entries.items():
             pid = started[name]
             shown = as_proc_shows(entry["command"])
             words = len(shown)  # a forked process takes on its command line a moment after its start
-            cmdline = wait_until(lambda p=pid, n=words: len(argv := _argv(p)) == n and argv, 10, f"{name}'s argv")
+            cmdline = wait_until(lambda p=pid, n=words: len(argv := proc_argv(p)) == n and argv, 10, f"{name}'s argv")
             for index, word in enumerate(shown):  # a start writes its parameter files anew, under new names
                 if word in entry["written_parameters"]:
                     assert _yaml(cmdline[index]) == entry["written_parameters"][word]
@@ -151,7 +141,7 @@ def test_explain_lists_exactly_what_a_start_then_runs(demo, tmp_path: Path) -> N
             expected = {**roc_environ, **entry["env"]}
             for variable in entry["unset"]:
                 expected.pop(variable)
-            assert {k: v for k, v in _environ(pid).items() if k != "ROC_LAUNCH_ID"} == expected, name
+            assert {k: v for k, v in proc_environ(pid).items() if k != "ROC_LAUNCH_ID"} == expected, name
     finally:
         assert launcher.stop() == 0, launcher.output()
     assert not kill_leftovers(str(tmp_path))

@@ -16,40 +16,16 @@ import time
 from pathlib import Path
 
 import pytest
-from explain_helpers import as_proc_shows
+from explain_helpers import as_proc_shows, proc_argv, proc_environ
 from graph_helpers import roc, stop_daemon
 from launch_helpers import demo_env, kill_leftovers, roc_launch, wait_for_nodes, wait_until
-from ssh_server import ssh_server
+from remote_helpers import REMOTE, alive, ancestors, comm, ssh_server, sshd_session, write_pair
 
 from roc.launch.guard import GRACE_SECONDS
 from roc.launch.remote_guard import SILENCE_SECONDS
 
 pytestmark = pytest.mark.slow
 LOAD_MARGIN = 15.0  # a loaded CI machine: seconds beyond the documented bound before the test fails
-REMOTE = "robot:local/far_listener"
-SYSTEM = """
-[launch.pair.hosts."robot"]
-setup = "{setup}"
-
-[[launch.pair.process]]
-package = "roc_launch_demo"
-executable = "talker"
-namespace = "local"
-parameters = {{ rate = 5.0 }}
-
-[[launch.pair.process]]
-package = "roc_launch_demo"
-executable = "listener"
-name = "far_listener"
-namespace = "local"
-host = "{host}"
-env = {{ ROC_TEST_MARK = "far" }}
-respawn = {respawn}
-respawn-delay = 0.2
-after = ["process local/talker started"]
-"""
-
-
 @pytest.fixture(scope="module")
 def remote(tmp_path_factory, launch_demo_prefix):
     """The test's domain, with roc_launch_demo sourced, and an sshd whose login sources it (its setup)."""
@@ -63,9 +39,6 @@ def remote(tmp_path_factory, launch_demo_prefix):
             kill_leftovers(str(prefix))
 
 
-def _system(tmp_path: Path, prefix: Path, host: str = "robot", respawn: bool = False) -> None:
-    (tmp_path / "roc.toml").write_text(SYSTEM.format(setup=prefix.parent / "setup.bash", host=host,
-                                                     respawn=str(respawn).lower()))
 
 
 def _pids(output: str, name: str) -> list[int]:
@@ -73,35 +46,18 @@ def _pids(output: str, name: str) -> list[int]:
                                            output)]
 
 
-def _alive(pid: int) -> bool:
-    try:
-        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] not in ("Z", "X")
-    except OSError:
-        return False
 
 
-def _ancestors(pid: int) -> list[str]:
-    """The names of a process's ancestors, nearest first."""
-    names = []
-    while pid > 1:
-        pid = int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
-        names.append(Path(f"/proc/{pid}/comm").read_text().strip())
-    return names
 
 
-def _cmdline(pid: int) -> list[str]:
-    return Path(f"/proc/{pid}/cmdline").read_bytes().decode().split("\0")[:-1]
 
 
-def _environ(pid: int) -> dict[str, str]:
-    entries = Path(f"/proc/{pid}/environ").read_bytes().decode().split("\0")
-    return dict(entry.split("=", 1) for entry in entries if "=" in entry)
 
 
 def _stopped_within(pid: int, bound: float, what: str) -> float:
     """Seconds until ``pid`` has ended (failing the test past ``bound`` + LOAD_MARGIN)."""
     started = time.monotonic()
-    wait_until(lambda: not _alive(pid), bound + LOAD_MARGIN, f"the remote process to stop after {what}", period=0.05)
+    wait_until(lambda: not alive(pid), bound + LOAD_MARGIN, f"the remote process to stop after {what}", period=0.05)
     elapsed = time.monotonic() - started
     print(f"remote process stopped {elapsed:.2f} s after {what} (documented bound {bound:g} s)")
     return elapsed
@@ -109,7 +65,7 @@ def _stopped_within(pid: int, bound: float, what: str) -> float:
 
 def test_a_remote_process_runs_beside_a_local_one_as_explained(remote, tmp_path: Path) -> None:
     env, prefix, _ = remote
-    _system(tmp_path, prefix)
+    write_pair(tmp_path, prefix)
     explained = roc("-C", str(tmp_path), "launch", "pair", "--explain", "--format", "json", env=env)
     assert explained.returncode == 0, explained.stderr
     talker, listener = json.loads(explained.stdout)
@@ -121,20 +77,20 @@ def test_a_remote_process_runs_beside_a_local_one_as_explained(remote, tmp_path:
         output = launcher.output()
         local_pid, = _pids(output, "local/talker")
         remote_pid, = _pids(output, REMOTE)
-        assert "sshd" in _ancestors(remote_pid) and launcher.pid not in _ancestor_pids(remote_pid)
+        assert "sshd" in map(comm, ancestors(remote_pid)) and launcher.pid not in ancestors(remote_pid)
         for entry, pid in ((talker, local_pid), (listener, remote_pid)):  # --explain said what runs
-            assert _cmdline(pid) == as_proc_shows(entry["command"])
+            assert proc_argv(pid) == as_proc_shows(entry["command"])
             assert os.readlink(f"/proc/{pid}/cwd") == entry["cwd"]
-            environ = _environ(pid)
+            environ = proc_environ(pid)
             assert {name: environ.get(name) for name in entry["env"]} == entry["env"]
         assert listener["host"] == "robot" and listener["env"]["ROC_TEST_MARK"] == "far"
         assert listener["env"]["ROS_DOMAIN_ID"] == env["ROS_DOMAIN_ID"]  # the system's ROS settings
-        assert _environ(remote_pid)["ROC_LAUNCH_ID"].endswith("@robot/local/far_listener")
-        local_env = {k: v for k, v in _environ(local_pid).items() if k != "ROC_LAUNCH_ID"}
-        assert local_env == {k: v for k, v in _environ(launcher.pid).items()}  # roc's own, nothing added
+        assert re.fullmatch(r".+@robot/local/far_listener/1", proc_environ(remote_pid)["ROC_LAUNCH_ID"])
+        local_env = {k: v for k, v in proc_environ(local_pid).items() if k != "ROC_LAUNCH_ID"}
+        assert local_env == {k: v for k, v in proc_environ(launcher.pid).items()}  # roc's own, nothing added
     finally:
         assert launcher.stop() == 0, launcher.output()
-    assert not _alive(remote_pid) and not _alive(local_pid)
+    assert not alive(remote_pid) and not alive(local_pid)
     output = launcher.output()
     assert f"[INFO] [{REMOTE}]: sending signal 'SIGINT' to process[{REMOTE}]" in output
     assert f"[INFO] [{REMOTE}]: process has finished cleanly [pid {remote_pid}]" in output
@@ -142,12 +98,6 @@ def test_a_remote_process_runs_beside_a_local_one_as_explained(remote, tmp_path:
     assert "[local.far_listener]: heard: hello" in log
 
 
-def _ancestor_pids(pid: int) -> list[int]:
-    pids = []
-    while pid > 1:
-        pid = int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
-        pids.append(pid)
-    return pids
 
 
 def _ready(output: str) -> int:
@@ -164,24 +114,17 @@ def _ssh_client(launcher_pid: int) -> int:
     return clients[0].pid
 
 
-def _sshd_session(remote_pid: int) -> int:
-    """The sshd process on the server's side of the remote process's session (its nearest sshd ancestor)."""
-    pid = remote_pid
-    while True:
-        pid = int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
-        if Path(f"/proc/{pid}/comm").read_text().strip() == "sshd":
-            return pid
 
 
 def test_no_remote_process_outlives_a_failure(remote, tmp_path: Path) -> None:
     """Its ssh client killed, its sshd session killed, the network cut (each time roc starts it again: it
     respawns), then roc killed: each time the process on the host stops within the documented bound."""
     env, prefix, server = remote
-    _system(tmp_path, prefix, respawn=True)
+    write_pair(tmp_path, prefix, respawn=True)
     launcher = roc_launch("pair", env=env, log=tmp_path / "roc.log")
     failures = {  # what fails -> how, and the bound of roc/launch/remote_guard.py
         "its ssh client killed": (lambda _pid: os.kill(_ssh_client(launcher.pid), signal.SIGKILL), GRACE_SECONDS),
-        "its sshd session killed": (lambda pid: os.kill(_sshd_session(pid), signal.SIGKILL), GRACE_SECONDS),
+        "its sshd session killed": (lambda pid: os.kill(sshd_session(pid), signal.SIGKILL), GRACE_SECONDS),
         "the network cut": (lambda _pid: server.relay.cut(), SILENCE_SECONDS + GRACE_SECONDS),
         "SIGKILL of roc": (lambda _pid: launcher.stop(signal.SIGKILL), GRACE_SECONDS),
     }
@@ -196,13 +139,13 @@ def test_no_remote_process_outlives_a_failure(remote, tmp_path: Path) -> None:
     output = launcher.output()
     assert output.count(f"[WARNING] [{REMOTE}]: the connection to 'robot' was lost (ssh ") == 3, output
     assert output.count(f"[ERROR] [{REMOTE}]: process has died [pid ") == 3  # lost, never stopped otherwise
-    assert not any(_alive(pid) for pid in _pids(output, REMOTE))
+    assert not any(alive(pid) for pid in _pids(output, REMOTE))
     wait_until(lambda: not kill_leftovers(str(prefix)), 2 * GRACE_SECONDS + LOAD_MARGIN, "the local guard's sweep")
 
 
 def test_an_unreachable_host_fails_before_anything_starts(remote, tmp_path: Path) -> None:
     env, prefix, server = remote
-    _system(tmp_path, prefix, host="nowhere")
+    write_pair(tmp_path, prefix, host="nowhere")
     error = "host 'nowhere' cannot be reached: ssh: connect to host 127.0.0.1 port {port}: Connection refused"
     port = re.search(r"Host nowhere\n  HostName 127.0.0.1\n  Port (\d+)", server.config.read_text()).group(1)
     for extra in ((), ("--check", str(tmp_path / "roc.toml")), ("--explain",)):
@@ -223,7 +166,7 @@ def _roc() -> list[str]:
 
 def test_a_missing_executable_or_setup_file_fails_before_anything_starts(remote, tmp_path: Path) -> None:
     env, prefix, _ = remote
-    _system(tmp_path, prefix)
+    write_pair(tmp_path, prefix)
     text = (tmp_path / "roc.toml").read_text()
     (tmp_path / "roc.toml").write_text(text.replace('executable = "listener"', 'executable = "listner"'))
     started = subprocess.run([*_roc(), "launch", "pair"], cwd=tmp_path, env=env, capture_output=True, text=True,

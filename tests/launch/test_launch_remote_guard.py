@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
+from remote_helpers import alive
 
 from roc.errors import UsageError
 from roc.launch.remote import REMOTE_COMMAND, payload
@@ -59,11 +60,6 @@ def _run_spec(tmp_path: Path, **changes) -> dict:
             "token": f"test-{os.getpid()}-{time.monotonic_ns()}", **changes}
 
 
-def _alive(pid: int) -> bool:
-    try:
-        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] not in ("Z", "X")
-    except OSError:
-        return False
 
 
 def test_the_guard_stops_its_process_when_the_session_ends(tmp_path: Path) -> None:
@@ -76,13 +72,13 @@ def test_the_guard_stops_its_process_when_the_session_ends(tmp_path: Path) -> No
         assert guard.stdout is not None
         assert guard.stdout.readline() == b"sleeping with hello --ros-args -r __node:=x\n"  # straight into the session
         pid = started["pid"]
-        assert _alive(pid)
+        assert alive(pid)
         assert guard.stdin is not None
         guard.stdin.close()  # the session ends: roc, its ssh or the connection is gone
         assert guard.wait(timeout=GRACE_SECONDS + 10) == 128 + signal.SIGTERM
     finally:
         guard.kill()
-    assert not _alive(pid)
+    assert not alive(pid)
     exited = [event for event in _events(guard.stderr) if event["event"] == "exited"]
     assert exited == [{"event": "exited", "code": -signal.SIGTERM, "reason": "the SSH session closed"}]
 
@@ -98,11 +94,12 @@ def test_the_guard_passes_signals_to_its_process_and_reports_its_exit(tmp_path: 
         assert guard.wait(timeout=20) == 128 + signal.SIGINT
     finally:
         guard.kill()
-    assert not _alive(pid)
+    assert not alive(pid)
     assert [e for e in _events(guard.stderr) if e["event"] == "exited"] == [
         {"event": "exited", "code": -signal.SIGINT, "reason": ""}]
 
 
+@pytest.mark.slow  # six Pythons started
 @pytest.mark.parametrize("change, error", [
     ({"executable": "sleepr"}, "package 'demo' has no executable 'sleepr' (its executables: sleeper)"),
     ({"package": "nope"}, "package 'nope' is not installed ({prefix})"),

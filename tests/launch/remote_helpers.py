@@ -1,11 +1,13 @@
-"""An SSH server on 127.0.0.1 for the tests of roc launch's processes on other hosts: Debian's
-openssh-server (``sshd``, installed by ``ROC_SETUP_TEST_TOOLS=1 bash scripts/setup.sh``) started by the
-test with a configuration of its own in the test's directory, a throwaway host key and user key, on a free
-port; never the system's sshd.
+"""What the tests of roc launch's processes on other hosts and bench/launch_remote_bench.py share.
 
-Its ``ssh_config`` names the server ``robot`` (through a relay that can cut the connection without
-closing it, as a pulled cable does), ``robot-direct``, and ``nowhere`` (a port nothing listens on). roc
-uses it through ``ROC_SSH_COMMAND="ssh -F ssh_config"`` (``env()``).
+- ``ssh_server``: an SSH server on 127.0.0.1, Debian's openssh-server (``sshd``, installed by
+  ``ROC_SETUP_TEST_TOOLS=1 bash scripts/setup.sh``) started with a configuration of its own in the test's
+  directory, a throwaway host key and user key, on a free port; never the system's sshd. Its ``ssh_config``
+  names it ``robot`` (through a relay that can cut the connection without closing it, as a pulled cable
+  does), ``robot-direct``, and ``nowhere`` (a port nothing listens on). roc uses it through
+  ``ROC_SSH_COMMAND="ssh -F ssh_config"`` (``SshServer.env()``).
+- ``write_pair``: a roc.toml system of a local talker and a listener on another host.
+- what a test reads of a process in /proc: ``alive``, ``ancestors``, ``sshd_session``.
 """
 
 from __future__ import annotations
@@ -24,6 +26,66 @@ from pathlib import Path
 
 import pytest
 from build_helpers import stop_process
+
+PAIR = """
+[launch.pair.hosts."robot"]
+setup = "{setup}"
+
+[[launch.pair.process]]
+package = "roc_launch_demo"
+executable = "talker"
+namespace = "local"
+parameters = {{ rate = 5.0 }}
+
+[[launch.pair.process]]
+package = "roc_launch_demo"
+executable = "listener"
+name = "far_listener"
+namespace = "local"
+host = "{host}"
+env = {{ ROC_TEST_MARK = "far" }}
+respawn = {respawn}
+respawn-delay = 0.2
+after = ["process local/talker started"]
+"""
+REMOTE = "robot:local/far_listener"  # the remote process, as roc's output names it
+
+
+def write_pair(directory: Path, prefix: Path, host: str = "robot", respawn: bool = False) -> None:
+    """``[launch.pair]`` in ``directory``/roc.toml: roc_launch_demo's talker here, its listener on ``host``,
+    which sources the setup.bash of ``prefix``'s install."""
+    (directory / "roc.toml").write_text(PAIR.format(setup=prefix.parent / "setup.bash", host=host,
+                                                    respawn=str(respawn).lower()))
+
+
+def _stat(pid: int) -> list[str]:
+    return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+
+
+def alive(pid: int) -> bool:
+    try:
+        return _stat(pid)[0] not in ("Z", "X")
+    except OSError:
+        return False
+
+
+def ancestors(pid: int) -> list[int]:
+    """A process's ancestors, nearest first."""
+    found = []
+    while pid > 1:
+        pid = int(_stat(pid)[1])
+        found.append(pid)
+    return found
+
+
+def comm(pid: int) -> str:
+    return Path(f"/proc/{pid}/comm").read_text().strip()
+
+
+def sshd_session(pid: int) -> int:
+    """The sshd process on the server's side of a remote process's session (its nearest sshd ancestor)."""
+    return next(ancestor for ancestor in ancestors(pid) if comm(ancestor) == "sshd")
+
 
 SSHD = shutil.which("sshd") or next((p for p in ("/usr/sbin/sshd",) if os.access(p, os.X_OK)), None)
 
