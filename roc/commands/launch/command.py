@@ -160,17 +160,17 @@ def _run_system(args: argparse.Namespace, words: list[str]) -> int:
     if args.print_description or args.show_args or args.launch_prefix or args.show_all_subprocesses_output:
         raise UsageError("--print, --show-args, --launch-prefix and -a are for launch files")
     system = load_system(roc_toml, args.target)
+    options = None if args.explain else _run_options(args, f"roc launch {args.target}")
     found: dict[str, dict] = {}
     if system.remote():  # every host reachable, with every executable, before anything starts
         from roc.launch.remote import check_hosts
 
         found = check_hosts(system, dict(os.environ))
-    if args.explain:
+    if options is None:
         return _explain_system(args, system, found)
     from roc.launch.system_run import launch_system
 
-    return launch_system(system, _run_options(args, f"roc launch {args.target}"), not args.no_daemon,
-                         args.spin_time)
+    return launch_system(system, options, not args.no_daemon, args.spin_time)
 
 
 def _explain_system(args: argparse.Namespace, system, found: dict[str, dict]) -> int:
