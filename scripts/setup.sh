@@ -8,9 +8,10 @@
 # .venv/.roc-setup-stamp) it only re-checks the fix-ups and prints one line.
 # Only the dev/CI environment lives here: roc itself never assumes the venv's paths.
 # It changes nothing outside the checkout (and pip's cache) unless asked:
-#   ROC_SETUP_TEST_TOOLS=1  also install zsh, fish, tmux and ccache with the system's package manager
-#                       (apt-get, as root), so that the tests of roc's zsh/fish setup scripts and
-#                       completions, of roc tui in a real terminal and of --compiler-cache ccache run
+#   ROC_SETUP_TEST_TOOLS=1  also install zsh, fish, tmux, ccache and openssh-server with the system's
+#                       package manager (apt-get, as root), so that the tests of roc's zsh/fish setup
+#                       scripts and completions, of roc tui in a real terminal, of --compiler-cache ccache
+#                       and of roc launch's processes on other hosts (an sshd the test starts) run
 #                       instead of skipping; CI sets it (.ci/run). Without
 #                       it, missing tools are only reported. roc itself needs none of them.
 # Environment: PYTHON (interpreter that creates the venv, default python3),
@@ -61,12 +62,14 @@ EOF
 }
 
 # ---- test-time tools (opt-in: their tests skip without them): the shells the tests source roc's
-# setup scripts in, tmux, which runs roc tui in a real terminal, and ccache (a compiler cache). Installed only with
+# setup scripts in, tmux, which runs roc tui in a real terminal, ccache (a compiler cache) and sshd (the
+# SSH server roc launch's remote-process tests start on localhost, never as a service). Installed only with
 # ROC_SETUP_TEST_TOOLS=1; otherwise a full set-up says which are missing.
 setup_test_tools() {
     local missing=() tool
-    for tool in zsh fish tmux ccache; do
-        command -v "$tool" >/dev/null 2>&1 || missing+=("$tool")
+    # command:package (the package is the command's name unless given)
+    for tool in zsh fish tmux ccache sshd:openssh-server; do
+        command -v "${tool%%:*}" >/dev/null 2>&1 || missing+=("${tool#*:}")
     done
     [ "${#missing[@]}" -gt 0 ] || return 0
     if [ "${ROC_SETUP_TEST_TOOLS:-0}" != 1 ]; then
