@@ -1,0 +1,243 @@
+"""``roc work build --cluster`` and ``roc work test --cluster`` end to end, on real servers on localhost:
+a Dask scheduler, two roc workers whose roots are at different paths (one started by ``roc work
+worker``, one by Dask's own ``dask worker --preload roc.cluster.worker``), and the WebDAV store of the
+remote cache tests. The workspace is a diamond (dia_a; dia_b and dia_c on it; dia_d on both) with C++
+and Python packages (workspaces/fixtures/cluster_diamond).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+import time
+
+import psutil
+import pytest
+from build_helpers import BIN, FIXTURES, in_sourced_shell, installed_files, roc, ros_env
+from cluster_servers import (
+    _wait,
+    building,
+    dask_cluster,
+    kill_processes,
+    scheduler_workers,
+    sitecustomize_audit,
+    worker_process,
+)
+from remote_servers import free_port, webdav
+
+pytestmark = pytest.mark.slow
+
+PACKAGES = {"dia_a", "dia_b", "dia_c", "dia_d"}
+RUN_ALL = "dia_a_hello; dia_b_app; install/dia_c/lib/dia_c/dia_c_hello; dia_d_app"
+PROGRAMS_SAY = ("dia_a says 42", "dia_b uses dia_a: 42", "dia_c doubles 21: 42", "dia_d on top: 43")
+
+
+def _checkout(base, name):
+    """Sources only, as a fresh clone has them."""
+    ws = base / name
+    shutil.copytree(FIXTURES / "cluster_diamond" / "src", ws / "src")
+    return ws
+
+
+def _events(ws, verb="build") -> list[dict]:
+    return [json.loads(line) for line in (ws / "log" / f"latest_{verb}" / "events.log").read_text().splitlines()]
+
+
+def _finished_on(ws, verb="build") -> dict[str, str]:
+    return {e["task"]: e["worker"] for e in _events(ws, verb) if e["event"] == "TaskFinished" and e["worker"]}
+
+
+@pytest.fixture(scope="module")
+def servers(tmp_path_factory):
+    """The WebDAV store and the Dask cluster, shared by the module: (scheduler address, cache URL,
+    environment, worker processes by name, worker roots by name)."""
+    base = tmp_path_factory.mktemp("servers")
+    (base / "dav").mkdir()
+    env = ros_env()
+    with webdav(base / "dav") as port, dask_cluster(base, env, {"worker-1": "roc", "worker-2": "dask"}) as cluster:
+        address, processes, roots = cluster
+        yield address, f"http://127.0.0.1:{port}/diamond", env, processes, roots
+
+
+def _build(ws, servers, *extra, env=None, timeout=600):
+    address, url, base_env, _, _ = servers
+    return roc("work", "build", "--cluster", address, "--remote-cache", url, *extra, cwd=ws, env=env or base_env,
+               timeout=timeout)
+
+
+@pytest.fixture(scope="module")
+def built(servers, tmp_path_factory):
+    """A checkout built on the cluster, every process the client started logged (Python's audit hook)."""
+    base = tmp_path_factory.mktemp("client")
+    ws = _checkout(base, "client checkout")
+    audit = base / "started.log"
+    audit.touch()
+    result = _build(ws, servers, env={**servers[2], **sitecustomize_audit(base / "audit", audit)})
+    assert result.returncode == 0, result.stdout + result.stderr
+    return ws, result, audit.read_text()
+
+
+def test_diamond_builds_on_both_workers_and_the_client_runs_no_build_tool(built, servers):
+    ws, result, started = built
+    on = _finished_on(ws)
+    assert set(on) == PACKAGES, result.stdout
+    assert on["dia_b"] != on["dia_c"] and set(on.values()) == {"worker-1", "worker-2"}, result.stdout
+    for name, worker in on.items():
+        assert re.search(rf"^Finished <<< {name} \[[0-9.]+s on {worker}\]$", result.stdout, re.MULTILINE), result.stdout
+    assert "(0 built here, 4 on the cluster, 0 up to date)" in result.stdout
+    # the client itself started no build tool (no compiler, no cmake, no setup.py); Dask's client asks
+    # `uname -p` once, for the versions it compares with the scheduler's
+    assert [line for line in started.splitlines() if "'uname', '-p'" not in line] == [], started
+    # the workers built in roots of their own, at paths the client does not have
+    for root in servers[4].values():
+        assert list((root / "work").glob("*/install/dia_a/lib/libdia_a.so")) or list((root / "work").glob("*/src"))
+
+
+def test_install_tree_equals_a_local_build_and_its_programs_run(built, tmp_path):
+    ws, _, _ = built
+    local = _checkout(tmp_path, "local")
+    here = roc("work", "build", cwd=local)
+    assert here.returncode == 0, here.stdout + here.stderr
+    remote_files = {f for f in installed_files(ws / "install") if not f.endswith(".pyc")}
+    assert remote_files == {f for f in installed_files(local / "install") if not f.endswith(".pyc")}
+    for name in sorted(remote_files):  # text files (scripts, hooks, CMake configs) the same, at each one's path
+        mine, theirs = (ws / "install" / name), (local / "install" / name)
+        if mine.is_file() and not mine.is_symlink() and b"\0" not in mine.read_bytes()[:8192]:
+            a = mine.read_bytes().replace(str(ws).encode(), b"WS")
+            b = theirs.read_bytes().replace(str(local).encode(), b"WS")
+            assert a == b, f"install/{name} differs from a local build's"
+    ran = in_sourced_shell(ws, RUN_ALL)
+    assert ran.returncode == 0, ran.stderr
+    for said in PROGRAMS_SAY:
+        assert said in ran.stdout
+
+
+def test_a_second_run_and_another_checkout_submit_no_task(built, servers, tmp_path):
+    ws, _, _ = built
+    again = _build(ws, servers)
+    assert again.returncode == 0 and "4 packages up to date" in again.stdout, again.stdout + again.stderr
+    other = _checkout(tmp_path / "elsewhere", "checkout")
+    restored = _build(other, servers)
+    assert restored.returncode == 0, restored.stdout + restored.stderr
+    events = _events(other)
+    assert not [e for e in events if e["event"] == "TaskStarted"], restored.stdout  # nothing ran, nothing sent
+    assert {e["task"] for e in events if e["event"] == "TaskFinished" and e["restored"]} == PACKAGES
+    assert " on worker-" not in restored.stdout
+
+
+def test_a_worker_killed_while_building_is_replaced(servers, built, tmp_path):
+    """dia_b's configure is made slow; the worker building it is killed (SIGKILL) and Dask runs the task
+    again on a worker: the build succeeds, and no half-written cache entry is ever restored."""
+    ws, _, _ = built
+    killed = _checkout(tmp_path, "killed")
+    cmakelists = killed / "src" / "dia_b" / "CMakeLists.txt"
+    cmakelists.write_text(cmakelists.read_text().replace(
+        "find_package(dia_a REQUIRED)", "find_package(dia_a REQUIRED)\nexecute_process(COMMAND ${CMAKE_COMMAND} -E sleep 4)"))
+    address, url, env, processes, _ = servers
+    client = subprocess.Popen([str(BIN / "roc"), "work", "build", "--cluster", address, "--remote-cache", url],
+                              cwd=killed, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        victim = _wait(lambda: next((n for n, p in processes.items() if building(p, "/build/dia_b")), None),
+                       "a worker building dia_b", process=client)
+        worker = worker_process(processes[victim])
+        below = worker.children(recursive=True)
+        worker.kill()
+        kill_processes(below)  # the killed worker's commands (a real crash would leave them to finish alone)
+        out, err = client.communicate(timeout=600)
+    finally:
+        if client.poll() is None:
+            client.kill()
+            client.wait()
+    assert client.returncode == 0, out + err
+    on = _finished_on(killed)
+    assert {"dia_b", "dia_d"} <= set(on), out
+    ran = in_sourced_shell(killed, "dia_b_app; dia_d_app")
+    assert ran.returncode == 0 and "dia_b uses dia_a: 42" in ran.stdout, ran.stderr
+    _wait(lambda: {"worker-1", "worker-2"} <= set(scheduler_workers(address)), "the killed worker back (its nanny)")
+
+
+def test_a_client_with_another_toolchain_finds_no_worker(servers, tmp_path):
+    ws = _checkout(tmp_path, "cflags")
+    other = _build(ws, servers, env={**servers[2], "CFLAGS": "-O1"})
+    assert other.returncode == 1
+    assert other.stderr.count("\n") == 1 and "no worker of the cluster at " in other.stderr, other.stderr
+    assert "worker-1" in other.stderr and "Traceback" not in other.stderr
+    assert not (ws / "install").exists()
+
+
+def test_a_worker_refuses_a_task_of_another_toolchain(servers, built):
+    """A task whose toolchain fingerprint is not the worker's (sent to it by name, past the resources
+    that keep such tasks away) is refused: nothing is built."""
+    import distributed
+    from roc.cluster import work
+    from roc.cluster.spec import PackageWork
+
+    package = {"name": "dia_a", "path": "src/dia_a", "type": "cmake", "dependencies": {}, "hooks": [],
+               "metadata": {}, "constraints": {}, "group_depends": [], "member_of_groups": []}
+    task = PackageWork(package=package, dependencies=[], key="0" * 64, portable={}, sources=b"", options={},
+                       cache_url=servers[1], cache_timeout=5, toolchain="not-this-one", toolchain_parts={})
+    with distributed.Client(servers[0], set_as_default=False) as client:
+        result = client.submit(work.build, task, workers=["worker-2"], pure=False).result(timeout=120)
+    assert not result.ok and result.refused and result.worker == "worker-2"
+    assert "worker worker-2 refused it: its toolchain differs from the client's" in result.reason
+
+
+def test_cluster_test_results_appear_in_test_result(built, servers):
+    ws, _, _ = built
+    address, url, env, _, _ = servers
+    tested = roc("work", "test", "--cluster", address, "--remote-cache", url, cwd=ws, env=env)
+    assert tested.returncode == 0, tested.stdout + tested.stderr
+    on = _finished_on(ws, "test")
+    assert {"dia_b", "dia_c"} <= set(on), tested.stdout
+    assert (ws / "build" / "dia_c" / "pytest.xml").is_file()
+    assert (ws / "build" / "dia_b" / "Testing" / "TAG").is_file()
+    summary = roc("work", "test-result", "--all", cwd=ws, env=env)
+    assert summary.returncode == 0, summary.stdout + summary.stderr
+    assert "Summary: 3 tests, 0 errors, 0 failures, 0 skipped" in summary.stdout, summary.stdout
+    cached = roc("work", "test", "--cluster", address, "--remote-cache", url, cwd=ws, env=env)
+    assert cached.returncode == 0 and " on worker-" not in cached.stdout, cached.stdout
+
+
+def test_no_scheduler_is_one_line_and_nothing_restored(servers, tmp_path):
+    ws = _checkout(tmp_path, "lonely")
+    address = f"tcp://127.0.0.1:{free_port()}"
+    start = time.monotonic()
+    result = roc("work", "build", "--cluster", address, "--remote-cache", servers[1], cwd=ws,
+                 env={**servers[2], "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT": "2s"})
+    assert result.returncode == 1 and time.monotonic() - start < 60
+    assert result.stderr.startswith(f"roc: error: cannot reach the Dask scheduler at {address}"), result.stderr
+    assert result.stderr.count("\n") == 1 and result.stdout == ""
+    assert not (ws / "install").exists() and not (ws / "build").exists()
+
+
+def test_symlink_install_builds_here_and_says_why(servers, tmp_path):
+    ws = _checkout(tmp_path, "symlinks")
+    result = _build(ws, servers, "--symlink-install", "--packages-select", "dia_a")
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert ("roc: warning: dia_a: built here, not on the cluster: --symlink-install installs links into the "
+            "sources") in result.stderr
+    assert "Finished <<< dia_a [" in result.stdout and " on worker-" not in result.stdout
+
+
+def test_ctrl_c_cancels_the_task_and_the_worker_stops_the_build(servers, tmp_path):
+    address, url, env, processes, _ = servers
+    ws = _checkout(tmp_path, "interrupted")
+    cmakelists = ws / "src" / "dia_a" / "CMakeLists.txt"
+    cmakelists.write_text(cmakelists.read_text() + "execute_process(COMMAND ${CMAKE_COMMAND} -E sleep 120)\n")
+    client = subprocess.Popen([str(BIN / "roc"), "work", "build", "--cluster", address, "--remote-cache", url],
+                              cwd=ws, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        victim = _wait(lambda: next((n for n, p in processes.items() if building(p, "/build/dia_a")), None),
+                       "a worker building dia_a", process=client)
+        client.send_signal(2)  # SIGINT, as Ctrl+C
+        out, err = client.communicate(timeout=60)
+    finally:
+        if client.poll() is None:
+            client.kill()
+            client.wait()
+    assert client.returncode == 130, out + err
+    assert "Aborted  <<< dia_a" in out and "Traceback" not in err
+    _wait(lambda: not building(processes[victim], "/build/dia_a"), "the worker to stop dia_a's build", timeout=30)
+    assert psutil.pid_exists(processes[victim].pid)  # the worker itself goes on
