@@ -15,6 +15,7 @@ import fcntl
 import os
 import shutil
 import tempfile
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -27,19 +28,21 @@ class WorkRoot:
     def __init__(self, root: Path, keep: int = 4):
         self.root, self.keep = root, keep
         self.work, self.done = root / "work", root / "done"
+        self._mutex = threading.Lock()  # a folder is locked before another thread of the worker tidies
 
     @contextlib.contextmanager
     def attempt(self, key: str, reuse: bool = False) -> Iterator[Path]:
         """A locked folder for one task on the package with remote key ``key``: with ``reuse``, the one
         of the last successful build of that key here, when no other task holds it."""
-        self.work.mkdir(parents=True, exist_ok=True)
-        self.done.mkdir(parents=True, exist_ok=True)
-        self._tidy()
-        folder = self._done_folder(key) if reuse else None
-        lock = _try_lock(folder) if folder is not None else None
-        if lock is None:
-            folder = Path(tempfile.mkdtemp(prefix=f"{key[:16]}-", dir=self.work))
-            lock = _try_lock(folder)
+        with self._mutex:
+            self.work.mkdir(parents=True, exist_ok=True)
+            self.done.mkdir(parents=True, exist_ok=True)
+            self._tidy()
+            folder = self._done_folder(key) if reuse else None
+            lock = _try_lock(folder) if folder is not None else None
+            if lock is None:
+                folder = Path(tempfile.mkdtemp(prefix=f"{key[:16]}-", dir=self.work))
+                lock = _try_lock(folder)
         assert folder is not None and lock is not None
         try:
             yield folder
