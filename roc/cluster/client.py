@@ -35,9 +35,15 @@ def _quiet_dask_logging() -> None:
 def connect(address: str, install_base: Path) -> Cluster:
     """Connect to the scheduler and check that a worker fits this workspace's toolchain: a RocError
     (one line) before anything is built; a note on stderr when the cluster has no worker yet."""
+    import importlib.util
+
     from roc.cluster.toolchain import client_fingerprint
+    from roc.errors import UsageError
     from roc.messages import warn
 
+    if importlib.util.find_spec("distributed") is None:
+        raise UsageError("--cluster needs Dask's distributed: pip install 'roc[cluster]' (or distributed) into "
+                         "roc's environment")
     digest, parts = client_fingerprint(install_base)
     cluster = Cluster(address, digest, parts)
     try:
@@ -59,9 +65,14 @@ class Cluster:
 
         _quiet_dask_logging()
         self.address, self.toolchain, self.toolchain_parts = address, toolchain, toolchain_parts or {}
+        security = distributed.security.Security()  # Dask's own settings (its configuration files, DASK_* variables)
+        if address.startswith("tls://") and not (security.tls_ca_file and security.tls_client_cert):
+            raise RocError(f"cannot reach the Dask scheduler at {address}: tls:// needs Dask's TLS settings for "
+                           "a client (distributed.comm.tls.ca-file, client.cert and client.key, e.g. "
+                           "$DASK_DISTRIBUTED__COMM__TLS__CA_FILE; see docs/cluster.md)")
         try:
-            self.client = distributed.Client(address, set_as_default=False)
-        except (OSError, TimeoutError, ValueError) as error:
+            self.client = distributed.Client(address, set_as_default=False, security=security)
+        except (OSError, TimeoutError, ValueError, TypeError) as error:
             reason = str(error).splitlines()[0] if str(error) else type(error).__name__
             raise RocError(f"cannot reach the Dask scheduler at {address}: {reason}") from None
         _quiet_dask_logging()

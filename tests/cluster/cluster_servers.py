@@ -172,3 +172,22 @@ def _audit(event, args, _log={str(log)!r}):
 sys.addaudithook(_audit)
 ''')
     return {"PYTHONPATH": os.pathsep.join(p for p in (str(folder), os.environ.get("PYTHONPATH", "")) if p)}
+
+
+def tls_files(folder: Path) -> tuple[Path, Path]:
+    """A self-signed certificate (its own CA) and its key, as Dask's Security.temporary makes them."""
+    from distributed.security import Security
+
+    temporary = Security.temporary()
+    folder.mkdir(parents=True, exist_ok=True)
+    cert, key = folder / "cert.pem", folder / "key.pem"
+    cert.write_text(temporary.tls_ca_file)
+    key.write_text(temporary.tls_client_key)
+    key.chmod(0o600)
+    return cert, key
+
+
+def tls_client_environment(cert: Path, key: Path) -> dict[str, str]:
+    """Dask's TLS settings for a client, as environment variables (what the manual tells users)."""
+    return {"DASK_DISTRIBUTED__COMM__TLS__CA_FILE": str(cert), "DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT": str(cert),
+            "DASK_DISTRIBUTED__COMM__TLS__CLIENT__KEY": str(key), "DASK_DISTRIBUTED__COMM__REQUIRE_ENCRYPTION": "True"}

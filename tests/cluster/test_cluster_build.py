@@ -23,6 +23,8 @@ from cluster_servers import (
     kill_processes,
     scheduler_workers,
     sitecustomize_audit,
+    tls_client_environment,
+    tls_files,
     worker_process,
 )
 from remote_servers import free_port, webdav
@@ -50,15 +52,22 @@ def _finished_on(ws, verb="build") -> dict[str, str]:
 
 
 @pytest.fixture(scope="module")
-def servers(tmp_path_factory):
-    """The WebDAV store and the Dask cluster, shared by the module: (scheduler address, cache URL,
-    environment, worker processes by name, worker roots by name)."""
+def dav(tmp_path_factory):
+    """The remote cache's WebDAV store, shared by the module: its URL."""
+    root = tmp_path_factory.mktemp("dav")
+    with webdav(root) as port:
+        yield f"http://127.0.0.1:{port}/diamond"
+
+
+@pytest.fixture(scope="module")
+def servers(dav, tmp_path_factory):
+    """The Dask cluster, shared by the module: (scheduler address, cache URL, environment, worker
+    processes by name, worker roots by name)."""
     base = tmp_path_factory.mktemp("servers")
-    (base / "dav").mkdir()
     env = ros_env()
-    with webdav(base / "dav") as port, dask_cluster(base, env, {"worker-1": "roc", "worker-2": "dask"}) as cluster:
+    with dask_cluster(base, env, {"worker-1": "roc", "worker-2": "dask"}) as cluster:
         address, processes, roots = cluster
-        yield address, f"http://127.0.0.1:{port}/diamond", env, processes, roots
+        yield address, dav, env, processes, roots
 
 
 def _build(ws, servers, *extra, env=None, timeout=600):
@@ -167,21 +176,48 @@ def test_a_client_with_another_toolchain_finds_no_worker(servers, tmp_path):
     assert not (ws / "install").exists()
 
 
-def test_a_worker_refuses_a_task_of_another_toolchain(servers, built):
-    """A task whose toolchain fingerprint is not the worker's (sent to it by name, past the resources
-    that keep such tasks away) is refused: nothing is built."""
+def _package(name: str, depends: tuple[str, ...] = ()) -> dict:
+    return {"name": name, "path": f"src/{name}", "type": "ros.cmake", "dependencies": {"build": set(depends)},
+            "hooks": [], "metadata": {}, "constraints": {}, "group_depends": [], "member_of_groups": []}
+
+
+def _run_on(servers, worker: str, task):
+    """A task sent straight to one worker (past the resources the client asks for), as another client could."""
     import distributed
     from roc.cluster import work
+
+    with distributed.Client(servers[0], set_as_default=False) as client:
+        return client.submit(work.build, task, workers=[worker], pure=False).result(timeout=120)
+
+
+def test_a_worker_refuses_a_task_of_another_toolchain(servers, built):
+    """A task whose toolchain fingerprint is not the worker's is refused: nothing is built."""
     from roc.cluster.spec import PackageWork
 
-    package = {"name": "dia_a", "path": "src/dia_a", "type": "cmake", "dependencies": {}, "hooks": [],
-               "metadata": {}, "constraints": {}, "group_depends": [], "member_of_groups": []}
-    task = PackageWork(package=package, dependencies=[], key="0" * 64, portable={}, sources=b"", options={},
-                       cache_url=servers[1], cache_timeout=5, toolchain="not-this-one", toolchain_parts={})
-    with distributed.Client(servers[0], set_as_default=False) as client:
-        result = client.submit(work.build, task, workers=["worker-2"], pure=False).result(timeout=120)
+    task = PackageWork(package=_package("dia_a"), dependencies=[], key="0" * 64, portable={}, sources=b"",
+                       options={}, cache_url=servers[1], cache_timeout=5, toolchain="not-this-one", toolchain_parts={})
+    result = _run_on(servers, "worker-2", task)
     assert not result.ok and result.refused and result.worker == "worker-2"
     assert "worker worker-2 refused it: its toolchain differs from the client's" in result.reason
+
+
+def test_a_dependency_the_cache_lacks_fails_the_package_with_the_reason(servers, built, tmp_path):
+    from roc.cluster.files import pack_files
+    from roc.cluster.spec import PackageWork
+    from roc.cluster.toolchain import fingerprint_parts
+    from roc.builder.fingerprint import combine
+    from roc.environment import with_implicit_underlay
+
+    parts = fingerprint_parts(with_implicit_underlay(servers[2]), tmp_path)
+    source = FIXTURES / "cluster_diamond" / "src" / "dia_b"
+    task = PackageWork(package=_package("dia_b", ("dia_a",)), dependencies=[(_package("dia_a"), "f" * 64)],
+                       key="1" * 64, portable={}, sources=pack_files(source, ["package.xml", "CMakeLists.txt", "main.cpp"]),
+                       options={}, cache_url=servers[1], cache_timeout=5, toolchain=combine(parts)[:16],
+                       toolchain_parts=parts)
+    result = _run_on(servers, "worker-1", task)
+    assert not result.ok and not result.refused, result
+    assert result.reason == ("worker worker-1 could not restore the dependency dia_a: not in the remote cache "
+                             "(key ffffffffffff)")
 
 
 def test_cluster_test_results_appear_in_test_result(built, servers):
@@ -241,3 +277,26 @@ def test_ctrl_c_cancels_the_task_and_the_worker_stops_the_build(servers, tmp_pat
     assert "Aborted  <<< dia_a" in out and "Traceback" not in err
     _wait(lambda: not building(processes[victim], "/build/dia_a"), "the worker to stop dia_a's build", timeout=30)
     assert psutil.pid_exists(processes[victim].pid)  # the worker itself goes on
+
+
+def test_a_tls_cluster_builds_and_refuses_a_client_without_its_certificate(dav, tmp_path):
+    """Dask's own TLS: the scheduler and the worker take Dask's TLS options, the client Dask's settings
+    (here its environment variables); a client without them gets one line."""
+    cert, key = tls_files(tmp_path / "tls")
+    env = ros_env(**tls_client_environment(cert, key))
+    tls = ("--protocol", "tls", "--tls-ca-file", str(cert), "--tls-cert", str(cert), "--tls-key", str(key))
+    with dask_cluster(tmp_path / "cluster", env, {"secure-worker": "roc"}, tls, tls) as (address, _, _):
+        assert address.startswith("tls://127.0.0.1:")
+        ws = _checkout(tmp_path, "tls")
+        source = ws / "src" / "dia_a" / "src" / "dia_a.cpp"
+        source.write_text(source.read_text() + "// built over TLS\n")
+        built = roc("work", "build", "--cluster", address, "--remote-cache", dav, "--packages-select", "dia_a",
+                    cwd=ws, env=env)
+        assert built.returncode == 0, built.stdout + built.stderr
+        assert re.search(r"^Finished <<< dia_a \[[0-9.]+s on secure-worker\]$", built.stdout, re.MULTILINE)
+        source.write_text(source.read_text() + "// again\n")
+        plain = roc("work", "build", "--cluster", address, "--remote-cache", dav, "--packages-select", "dia_a",
+                    cwd=ws, env={**ros_env(), "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT": "3s"})
+    assert plain.returncode == 1, plain.stdout + plain.stderr
+    assert plain.stderr.startswith(f"roc: error: cannot reach the Dask scheduler at {address}"), plain.stderr
+    assert plain.stderr.count("\n") == 1
