@@ -184,6 +184,7 @@ def _package(name: str, depends: tuple[str, ...] = ()) -> dict:
 def _run_on(servers, worker: str, task):
     """A task sent straight to one worker (past the resources the client asks for), as another client could."""
     import distributed
+
     from roc.cluster import work
 
     with distributed.Client(servers[0], set_as_default=False) as client:
@@ -202,10 +203,10 @@ def test_a_worker_refuses_a_task_of_another_toolchain(servers, built):
 
 
 def test_a_dependency_the_cache_lacks_fails_the_package_with_the_reason(servers, built, tmp_path):
+    from roc.builder.fingerprint import combine
     from roc.cluster.files import pack_files
     from roc.cluster.spec import PackageWork
     from roc.cluster.toolchain import fingerprint_parts
-    from roc.builder.fingerprint import combine
     from roc.environment import with_implicit_underlay
 
     parts = fingerprint_parts(with_implicit_underlay(servers[2]), tmp_path)

@@ -26,7 +26,7 @@ from roc.handlers.board import TaskBoard
 from roc.handlers.console import ConsoleHandler
 
 
-def _address(value, env_value=None, remote=object(), monkeypatch=None):
+def _address(value, env_value=None, remote="a remote cache", monkeypatch=None):
     if monkeypatch is not None:
         if env_value is None:
             monkeypatch.delenv("ROC_CLUSTER", raising=False)
