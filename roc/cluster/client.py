@@ -66,7 +66,8 @@ class Cluster:
         _quiet_dask_logging()
         self.address, self.toolchain, self.toolchain_parts = address, toolchain, toolchain_parts or {}
         security = distributed.security.Security()  # Dask's own settings (its configuration files, DASK_* variables)
-        if address.startswith("tls://") and not (security.tls_ca_file and security.tls_client_cert):
+        if address.startswith("tls://") and not (getattr(security, "tls_ca_file", None)
+                                                    and getattr(security, "tls_client_cert", None)):
             raise RocError(f"cannot reach the Dask scheduler at {address}: tls:// needs Dask's TLS settings for "
                            "a client (distributed.comm.tls.ca-file, client.cert and client.key, e.g. "
                            "$DASK_DISTRIBUTED__COMM__TLS__CA_FILE; see docs/cluster.md)")
@@ -127,6 +128,12 @@ class Cluster:
             except RocError:
                 pass  # the tasks that wait say so
         return self._capacity
+
+    def task_limit(self, local: int) -> int | Callable[[], int]:
+        """The engine's limit of tasks at once (roc.engine.executor.execute's ``workers``): as many as the
+        fitting workers build, at least ``local`` (--parallel-workers; 0: no limit), so that roc's ready
+        queue, not a queue on the workers, decides which package goes next."""
+        return local if not local else lambda: max(local, self.capacity())
 
     def run(self, function: Callable[[PackageWork], WorkResult], work: PackageWork, key: str,
             context: TaskContext, near: str | None = None) -> WorkResult:

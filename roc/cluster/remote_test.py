@@ -61,6 +61,8 @@ class ClusterTests:
     def _work(self, test: PackageTest, keys: dict[str, str | None]) -> PackageWork:
         options = test.options
         files = test.files or source_stamps(test.source, {})
+        built = read_state(options.build_base / test.package.name).get("parts") or {}
+        built_with = built.get("options", {})  # the CMake arguments of its build here, for the build there
         return PackageWork(
             package=plain_package(test.package),
             dependencies=[(plain_package(self.workspace.by_name[name]), keys[name] or "")
@@ -68,7 +70,8 @@ class ClusterTests:
             key=keys[test.package.name] or "",
             portable={},
             sources=pack_files(test.source, files),
-            options={"merge_install": options.merge_install},
+            options={"merge_install": options.merge_install, "cmake_args": tuple(built_with.get("cmake-args", ())),
+                     "ament_cmake_args": tuple(built_with.get("ament-cmake-args", ()))},
             cache_url=self.remote.settings.shown,
             cache_timeout=self.remote.settings.timeout,
             toolchain=self.cluster.toolchain,

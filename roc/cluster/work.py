@@ -158,7 +158,8 @@ class _Work:
         context = TaskContext(package.name, self.recorder, "build")
         missed = remote.restore(package, key, context)
         if missed is not None:
-            raise WorkFailed(f"worker {self.name} could not restore the dependency {package.name}: {missed}")
+            what = package.name if package.name == self.work.name else f"the dependency {package.name}"
+            raise WorkFailed(f"worker {self.name} could not restore {what}: {missed}")
         state = read_state(build_dir)
         write_state(build_dir, state.get("fingerprint"), state.get("files", {}), state.get("parts"), key)
 

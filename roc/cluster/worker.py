@@ -1,6 +1,6 @@
 """A Dask worker that builds roc packages: ``dask worker SCHEDULER --preload roc.cluster.worker
---roc-root DIR`` (what ``roc work worker`` runs, and what ``dask ssh``, dask-jobqueue or
-dask-kubernetes start with the same options).
+[--roc-root DIR]`` (what ``roc work worker`` runs), or any worker whose Dask configuration names the
+preload (``distributed.worker.preload``, as ``dask ssh``, dask-jobqueue and dask-kubernetes start them).
 
 The preload gives the worker its work root and advertises, as Dask resources, how many packages it
 builds at once (``roc-build``, 1 unless ``--resources roc-build=N`` says otherwise) and its toolchain
@@ -22,12 +22,13 @@ logger = logging.getLogger("distributed.worker")
 
 
 @click.command()
-@click.option("--roc-root", required=True, type=click.Path(file_okay=False),
-              help="the folder this worker builds in (a workspace per task below it)")
+@click.option("--roc-root", type=click.Path(file_okay=False),
+              help="the folder this worker builds in (a workspace per task below it; default: roc/ in the "
+                   "worker's own local directory, which Dask removes when the worker stops)")
 @click.option("--roc-keep", default=4, show_default=True, type=int,
               help="build folders kept for the test tasks of the same packages")
-def dask_setup(worker, roc_root: str, roc_keep: int) -> None:
-    root = Path(roc_root).absolute()
+def dask_setup(worker, roc_root: str | None, roc_keep: int) -> None:
+    root = Path(roc_root).absolute() if roc_root else Path(worker.local_directory) / "roc"
     root.mkdir(parents=True, exist_ok=True)
     worker.roc_work_root = WorkRoot(root, keep=roc_keep)
     state = worker.state

@@ -56,8 +56,9 @@ def start_scheduler(folder: Path, env: dict[str, str], *extra: str) -> tuple[sub
 
 
 def start_worker(address: str, root: Path, name: str, env: dict[str, str], via: str = "roc",
-                 dask_options: tuple[str, ...] = ()) -> subprocess.Popen:
-    """A roc worker (``via`` roc work worker or Dask's dask worker), its logs beside its root."""
+                 dask_options: tuple[str, ...] = (), prefix: tuple[str, ...] = ()) -> subprocess.Popen:
+    """A roc worker (``via`` roc work worker or Dask's dask worker), its logs beside its root; ``prefix``
+    runs it through another command (taskset)."""
     options = ["--host", "127.0.0.1", "--no-dashboard", *dask_options]
     if via == "roc":
         command = [str(BIN / "roc"), "work", "worker", address, "--root", str(root), "--name", name, "--dask-options", *options]
@@ -65,7 +66,7 @@ def start_worker(address: str, root: Path, name: str, env: dict[str, str], via: 
         command = [str(BIN / "dask"), "worker", address, "--preload", "roc.cluster.worker", "--roc-root", str(root),
                    "--name", name, "--nthreads", "1", "--resources", "roc-build=1", *options]
     with open(root.parent / f"{name}.log", "ab") as log:
-        return subprocess.Popen(command, stdout=log, stderr=log, stdin=subprocess.DEVNULL, env=env)
+        return subprocess.Popen([*prefix, *command], stdout=log, stderr=log, stdin=subprocess.DEVNULL, env=env)
 
 
 def scheduler_workers(address: str, env: dict[str, str] | None = None) -> dict[str, dict]:

@@ -304,7 +304,7 @@ def _build(args, workspace, options, switches: dict[str, bool], remote, compiler
                 durations, *(extra_handlers or [])]
     try:
         tasks = plan_build(workspace, options, jobserver, durations.durations, remote, compiler, cluster)
-        limit = workers if cluster is None or not workers else lambda: workers + cluster.cluster.capacity()
+        limit = workers if cluster is None else cluster.cluster.task_limit(workers)
         result = execute(tasks, handlers, limit, continue_on_error=args.continue_on_error, stop=stop)
     finally:
         jobserver.close()

@@ -147,7 +147,7 @@ def _test(args: argparse.Namespace, workspace, options, switches: dict[str, bool
         try:
             tasks = plan_tests(workspace, options, durations.durations, force=args.force, use_cache=not args.no_cache,
                                runner=cluster)
-            limit = workers if cluster is None or not workers else lambda: workers + cluster.cluster.capacity()
+            limit = workers if cluster is None else cluster.cluster.task_limit(workers)
             result = execute(tasks, handlers, limit, continue_on_error=not args.abort_on_error, kind=KIND)
         finally:
             for handler in handlers:
