@@ -15,7 +15,7 @@ import time
 
 import psutil
 import pytest
-from build_helpers import BIN, FIXTURES, in_sourced_shell, installed_files, roc, ros_env
+from build_helpers import BIN, FIXTURES, add_cmake_package, in_sourced_shell, installed_files, roc, ros_env
 from cluster_servers import (
     _wait,
     building,
@@ -256,6 +256,22 @@ def test_symlink_install_builds_here_and_says_why(servers, tmp_path):
     assert ("roc: warning: dia_a: built here, not on the cluster: --symlink-install installs links into the "
             "sources") in result.stderr
     assert "Finished <<< dia_a [" in result.stdout and " on worker-" not in result.stdout
+
+
+def test_a_package_bound_to_its_build_path_is_built_here(servers, tmp_path):
+    """A package whose installed file holds the absolute path it was built at (a path no rewrite
+    knows) cannot be restored at the client's path: built on a worker, then here, saying why."""
+    ws = tmp_path / "bound"
+    add_cmake_package(ws, "where_am_i", 'cmake_minimum_required(VERSION 3.8)\nproject(where_am_i NONE)\n'
+                      'file(WRITE ${CMAKE_BINARY_DIR}/where.txt "${CMAKE_INSTALL_PREFIX}\\n")\n'
+                      'install(FILES ${CMAKE_BINARY_DIR}/where.txt DESTINATION share/where_am_i)\n')
+    result = _build(ws, servers)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert re.search(r"roc: warning: where_am_i: built here, not on the cluster: built on worker-\d, its archive "
+                     r"holds the path it was built at \(where_am_i/share/where_am_i/where.txt\)", result.stderr), result.stderr
+    assert (ws / "install" / "where_am_i" / "share" / "where_am_i" / "where.txt").read_text() == \
+        f"{ws / 'install' / 'where_am_i'}\n"
+    assert " on worker-" not in result.stdout
 
 
 def test_ctrl_c_cancels_the_task_and_the_worker_stops_the_build(servers, tmp_path):
