@@ -53,6 +53,18 @@ def test_cluster_address_errors_and_sources(monkeypatch):
     assert _address("tcp://given:2", "tcp://from-env:1", monkeypatch=monkeypatch) == "tcp://given:2"
 
 
+def test_the_environment_wins_over_roc_toml(monkeypatch):
+    class FromFile:
+        def from_configuration(self, args, dest):
+            return dest == "cluster"
+
+    args = argparse.Namespace(cluster="tcp://from-roc-toml:1", configuration=FromFile())
+    monkeypatch.setenv("ROC_CLUSTER", "tcp://from-env:1")
+    assert cluster_address(args, "a remote cache") == "tcp://from-env:1"
+    monkeypatch.delenv("ROC_CLUSTER")
+    assert cluster_address(args, "a remote cache") == "tcp://from-roc-toml:1"
+
+
 def test_toolchain_differences_name_the_parts():
     mine = {"toolchain": {"tool c++": "a", "variable CFLAGS": None}, "platform": {"machine": "x86_64"}}
     theirs = {"toolchain": {"tool c++": "b", "variable CFLAGS": None}, "platform": {"machine": "aarch64"}}

@@ -120,12 +120,19 @@ def _cluster(args: argparse.Namespace, workspace, options):
 
     remote = remote_cache(args, workspace, options)
     address = cluster_address(args, remote)
-    if address is None or not workspace.selected:
-        return None
+    if address is None or not _anything_to_test(args, workspace, options):
+        return None  # cached results only: the cluster is not asked (nor Dask loaded)
     from roc.cluster.client import connect
     from roc.cluster.remote_test import ClusterTests
 
     return ClusterTests(connect(address, options.install_base), workspace, remote)
+
+
+def _anything_to_test(args: argparse.Namespace, workspace, options) -> bool:
+    from roc.testing.plan import plan_tests
+
+    return any(task.check is None or task.check()
+               for task in plan_tests(workspace, options, {}, force=args.force, use_cache=not args.no_cache))
 
 
 def _test(args: argparse.Namespace, workspace, options, switches: dict[str, bool], workers: int, cluster) -> int:
