@@ -7,11 +7,14 @@ and Python packages (workspaces/fixtures/cluster_diamond).
 
 from __future__ import annotations
 
+import contextlib
 import json
 import re
 import shutil
+import signal
 import subprocess
 import time
+from collections.abc import Iterator
 
 import psutil
 import pytest
@@ -74,6 +77,23 @@ def _build(ws, servers, *extra, env=None, timeout=600):
     address, url, base_env, _, _ = servers
     return roc("work", "build", "--cluster", address, "--remote-cache", url, *extra, cwd=ws, env=env or base_env,
                timeout=timeout)
+
+
+@contextlib.contextmanager
+def _building(ws, servers, package: str) -> Iterator[tuple[subprocess.Popen, str]]:
+    """A cluster build of ``ws`` in the background, from the moment a worker builds ``package``: the
+    client and that worker's name (the client is killed if the test leaves it running)."""
+    address, url, env, processes, _ = servers
+    client = subprocess.Popen([str(BIN / "roc"), "work", "build", "--cluster", address, "--remote-cache", url],
+                              cwd=ws, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        worker = _wait(lambda: next((n for n, p in processes.items() if building(p, f"/build/{package}")), None),
+                       f"a worker building {package}", process=client)
+        yield client, worker
+    finally:
+        if client.poll() is None:
+            client.kill()
+            client.communicate()
 
 
 @pytest.fixture(scope="module")
@@ -144,21 +164,13 @@ def test_a_worker_killed_while_building_is_replaced(servers, built, tmp_path):
     cmakelists = killed / "src" / "dia_b" / "CMakeLists.txt"
     cmakelists.write_text(cmakelists.read_text().replace(
         "find_package(dia_a REQUIRED)", "find_package(dia_a REQUIRED)\nexecute_process(COMMAND ${CMAKE_COMMAND} -E sleep 4)"))
-    address, url, env, processes, _ = servers
-    client = subprocess.Popen([str(BIN / "roc"), "work", "build", "--cluster", address, "--remote-cache", url],
-                              cwd=killed, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        victim = _wait(lambda: next((n for n, p in processes.items() if building(p, "/build/dia_b")), None),
-                       "a worker building dia_b", process=client)
+    address, _, _, processes, _ = servers
+    with _building(killed, servers, "dia_b") as (client, victim):
         worker = worker_process(processes[victim])
         below = worker.children(recursive=True)
         worker.kill()
         kill_processes(below)  # the killed worker's commands (a real crash would leave them to finish alone)
         out, err = client.communicate(timeout=600)
-    finally:
-        if client.poll() is None:
-            client.kill()
-            client.wait()
     assert client.returncode == 0, out + err
     on = _finished_on(killed)
     assert {"dia_b", "dia_d"} <= set(on), out
@@ -249,13 +261,20 @@ def test_no_scheduler_is_one_line_and_nothing_restored(servers, tmp_path):
     assert not (ws / "install").exists() and not (ws / "build").exists()
 
 
+def _data_package(ws, name: str) -> None:
+    """A CMake package that compiles nothing: it installs one file (the quickest real build)."""
+    add_cmake_package(ws, name, f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n"
+                                f"install(FILES package.xml DESTINATION share/{name})\n")
+
+
 def test_symlink_install_builds_here_and_says_why(servers, tmp_path):
-    ws = _checkout(tmp_path, "symlinks")
-    result = _build(ws, servers, "--symlink-install", "--packages-select", "dia_a")
+    ws = tmp_path / "symlinks"
+    _data_package(ws, "linked")
+    result = _build(ws, servers, "--symlink-install")
     assert result.returncode == 0, result.stdout + result.stderr
-    assert ("roc: warning: dia_a: built here, not on the cluster: --symlink-install installs links into the "
+    assert ("roc: warning: linked: built here, not on the cluster: --symlink-install installs links into the "
             "sources") in result.stderr
-    assert "Finished <<< dia_a [" in result.stdout and " on worker-" not in result.stdout
+    assert "Finished <<< linked [" in result.stdout and " on worker-" not in result.stdout
 
 
 def test_a_package_bound_to_its_build_path_is_built_here(servers, tmp_path):
@@ -275,21 +294,13 @@ def test_a_package_bound_to_its_build_path_is_built_here(servers, tmp_path):
 
 
 def test_ctrl_c_cancels_the_task_and_the_worker_stops_the_build(servers, tmp_path):
-    address, url, env, processes, _ = servers
+    processes = servers[3]
     ws = _checkout(tmp_path, "interrupted")
     cmakelists = ws / "src" / "dia_a" / "CMakeLists.txt"
     cmakelists.write_text(cmakelists.read_text() + "execute_process(COMMAND ${CMAKE_COMMAND} -E sleep 120)\n")
-    client = subprocess.Popen([str(BIN / "roc"), "work", "build", "--cluster", address, "--remote-cache", url],
-                              cwd=ws, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        victim = _wait(lambda: next((n for n, p in processes.items() if building(p, "/build/dia_a")), None),
-                       "a worker building dia_a", process=client)
-        client.send_signal(2)  # SIGINT, as Ctrl+C
+    with _building(ws, servers, "dia_a") as (client, victim):
+        client.send_signal(signal.SIGINT)  # as Ctrl+C
         out, err = client.communicate(timeout=60)
-    finally:
-        if client.poll() is None:
-            client.kill()
-            client.wait()
     assert client.returncode == 130, out + err
     assert "Aborted  <<< dia_a" in out and "Traceback" not in err
     _wait(lambda: not building(processes[victim], "/build/dia_a"), "the worker to stop dia_a's build", timeout=30)
@@ -304,16 +315,12 @@ def test_a_tls_cluster_builds_and_refuses_a_client_without_its_certificate(dav, 
     tls = ("--protocol", "tls", "--tls-ca-file", str(cert), "--tls-cert", str(cert), "--tls-key", str(key))
     with dask_cluster(tmp_path / "cluster", env, {"secure-worker": "roc"}, tls, tls) as (address, _, _):
         assert address.startswith("tls://127.0.0.1:")
-        ws = _checkout(tmp_path, "tls")
-        source = ws / "src" / "dia_a" / "src" / "dia_a.cpp"
-        source.write_text(source.read_text() + "// built over TLS\n")
-        built = roc("work", "build", "--cluster", address, "--remote-cache", dav, "--packages-select", "dia_a",
-                    cwd=ws, env=env)
+        ws = tmp_path / "tls"
+        _data_package(ws, "secret")
+        built = roc("work", "build", "--cluster", address, "--remote-cache", dav, cwd=ws, env=env)
         assert built.returncode == 0, built.stdout + built.stderr
-        assert re.search(r"^Finished <<< dia_a \[[0-9.]+s on secure-worker\]$", built.stdout, re.MULTILINE)
-        source.write_text(source.read_text() + "// again\n")
-        plain = roc("work", "build", "--cluster", address, "--remote-cache", dav, "--packages-select", "dia_a",
-                    cwd=ws, env={**ros_env(), "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT": "3s"})
+        assert re.search(r"^Finished <<< secret \[[0-9.]+s on secure-worker\]$", built.stdout, re.MULTILINE)
+        plain = roc("work", "build", "--cluster", address, "--remote-cache", dav, "--force", cwd=ws, env=ros_env())
     assert plain.returncode == 1, plain.stdout + plain.stderr
     assert plain.stderr.startswith(f"roc: error: cannot reach the Dask scheduler at {address}"), plain.stderr
     assert plain.stderr.count("\n") == 1
