@@ -130,22 +130,22 @@ class Cluster:
         return self._capacity
 
     def task_limit(self, local: int) -> int | Callable[[], int]:
-        """The engine's limit of tasks at once (roc.engine.executor.execute's ``workers``): as many as the
-        fitting workers build, at least ``local`` (--parallel-workers; 0: no limit), so that roc's ready
-        queue, not a queue on the workers, decides which package goes next."""
-        return local if not local else lambda: max(local, self.capacity())
+        """The engine's limit of tasks at once (roc.engine.executor.execute's ``workers``): twice what the
+        fitting workers build at once, so that each has its next package waiting while a result travels,
+        and at least ``local`` (--parallel-workers; 0: no limit). The rest stays in roc's ready queue,
+        and what waits on a worker waits in roc's order (each task's priority is the engine's)."""
+        return local if not local else lambda: max(local, 2 * self.capacity())
 
     def run(self, function: Callable[[PackageWork], WorkResult], work: PackageWork, key: str,
-            context: TaskContext, near: str | None = None) -> WorkResult:
+            context: TaskContext) -> WorkResult:
         """Run ``function(work)`` as the Dask task ``key`` and wait for its result; Ctrl+C or another
-        task's failure (``context`` cancelled) cancels it. ``near``: a worker to prefer (where the
-        package was built), not to wait for."""
+        task's failure (``context`` cancelled) cancels it."""
         from concurrent.futures import CancelledError
         from concurrent.futures import TimeoutError as FutureTimeout
 
         resources = {BUILD_RESOURCE: 1, resource_name(self.toolchain): 1}
         future = self.client.submit(function, work, key=key, resources=resources, pure=False,
-                                    workers=[near] if near else None, allow_other_workers=bool(near))
+                                    priority=context.priority)
         while True:
             try:
                 result = future.result(timeout=POLL_SECONDS)

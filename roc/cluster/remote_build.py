@@ -37,7 +37,6 @@ class ClusterBuilds:
     def __init__(self, cluster: Cluster, workspace: Workspace, remote: RemoteCache, compiler_cache: str | None = None):
         self.cluster, self.workspace, self.remote, self.compiler_cache = cluster, workspace, remote, compiler_cache
         self.here: dict[str, str] = {}  # packages built here, and why (their dependents are built here too)
-        self.built_on: dict[str, str] = {}  # package -> the worker that built it
 
     def action(self, build: _PackageBuild) -> Callable[[TaskContext], RanElsewhere | None]:
         return lambda context: self.run(build, context)
@@ -61,7 +60,6 @@ class ClusterBuilds:
         if missed is not None:
             self._here(build, context, f"built on {result.worker}, but not restored from the remote cache: {missed}")
             return None
-        self.built_on[build.package.name] = result.worker
         return RanElsewhere(result.worker, result.duration)
 
     def _here(self, build: _PackageBuild, context: TaskContext, why: str) -> None:

@@ -201,6 +201,7 @@ def execute(
                     handle(TaskFinished(task.name, task.kind, cached=True))
                     continue
                 context = TaskContext(task.name, events.put, task.kind)
+                context.priority = ready.priority(task.key)
                 pool.submit(_work, task, context, tuple(reasons or ()))
                 running[task.key] = context
             if not running:

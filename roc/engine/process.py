@@ -64,6 +64,7 @@ class TaskContext:
         self._lock = threading.Lock()
         self._process: subprocess.Popen | None = None
         self.cancelled = False
+        self.priority = 0.0  # how long a chain of work waits on this task (the ready queue's order)
 
     def emit(self, event: Event) -> None:
         self._emit(event)
