@@ -13,10 +13,11 @@ fresh copy and with a fresh remote cache (a new folder on one WebDAV server), co
 3. ``2 workers``: two workers, on cores 0 and 1, ``--parallel-workers 2``.
 
 Goals: 2 workers take <= 0.6x the time of 1; 1 worker <= 1.15x the local build (the cost of the
-cluster). The per-task overhead comes from the 1-worker run's events (one task in flight, so no task
-waits in a queue): on the worker, the time beyond its build commands (restoring the dependencies,
-uploading the archive); between client and worker, the rest of the task's time on the client
-(sending it, the result's return, restoring it into install/). They go to
+cluster). The per-task overhead: on the worker, the time beyond its build commands (restoring the
+dependencies, uploading the archive), from the 1-worker run's events; between client and worker (sending
+it, the result's return, restoring it into install/), the client's time beyond the worker's for each
+package of a chain of six that compile nothing, built after it on the same worker (one at a time:
+nothing waits in a queue). They go to
 ``bench/.work/cluster/overheads.json``, and cluster_sim.py replays the local build's durations with them
 on 8, 32 and 128 workers (goal: within 10 % of the bound up to 32). The machine's load average is
 printed before each build: it is shared, so repeat (``--rounds``) to see the spread.
@@ -69,41 +70,82 @@ def build(source: Path, name: str, command: list[str]) -> tuple[float, Path]:
     return elapsed, ws
 
 
-def cluster_build(source: Path, name: str, address: str, cache: str, workers: int, env: dict) -> tuple[float, Path]:
-    """A cold build on ``workers`` fresh workers, worker K pinned to core K, into a fresh cache."""
+def cluster_build(source: Path, name: str, address: str, cache: str, workers: int, env: dict,
+                  probe: bool = False) -> tuple[float, Path, float | None]:
+    """A cold build on ``workers`` fresh workers, worker K pinned to core K, into a fresh cache; with
+    ``probe``, then a chain of packages on them (the latency between client and worker)."""
     roots = BASE / f"{name}-roots"
     if roots.exists():
         shutil.rmtree(roots)
     started = []
+    command = [str(BIN / "roc"), "work", "build", "--cluster", address, "--remote-cache", f"{cache}/{uuid.uuid4().hex}",
+               "--parallel-workers", str(workers)]
     try:
         for index in range(workers):
             (roots / f"worker-{index}").mkdir(parents=True)
             started.append(start_worker(address, roots / f"worker-{index}", f"worker-{index}", env,
                                         prefix=("taskset", "-c", str(index))))
         wait_for_workers(address, {f"worker-{i}" for i in range(workers)}, processes=started)
-        return build(source, name, [str(BIN / "roc"), "work", "build", "--cluster", address, "--remote-cache",
-                                    f"{cache}/{uuid.uuid4().hex}", "--parallel-workers", str(workers)])
+        elapsed, ws = build(source, name, command)
+        probed = None
+        if probe:
+            build(chain(BASE / "chain-src"), "chain", command)
+            probed = latency(BASE / "chain")
+        return elapsed, ws, probed
     finally:
         stop_all(started)
 
 
-def task_overheads(ws: Path) -> dict[str, float]:
-    """From a cluster build's events (one task in flight): per task, the worker's time beyond its
-    build commands, and the client's time beyond the worker's."""
-    events = [json.loads(line) for line in (ws / "log" / "latest_build" / "events.log").read_text().splitlines()]
-    started = {e["task"]: e["time"] for e in events if e["event"] == "TaskStarted"}
+def _events(ws: Path) -> list[dict]:
+    return [json.loads(line) for line in (ws / "log" / "latest_build" / "events.log").read_text().splitlines()]
+
+
+def worker_overhead(ws: Path) -> float:
+    """Per task of a cluster build, the worker's time beyond its build commands (restoring the
+    dependencies, uploading the archive), in seconds."""
     commands: dict[str, list[float]] = {}
-    for event in events:
+    extra = []
+    for event in _events(ws):
         if event["event"] in ("CommandStarted", "CommandEnded"):
             commands.setdefault(event["task"], []).append(event["time"])
-    worker, latency = [], []
-    for event in events:
-        if event["event"] == "TaskFinished" and event.get("worker") and event["task"] in commands:
+        elif event["event"] == "TaskFinished" and event.get("worker") and event["task"] in commands:
             times = commands[event["task"]]
-            worker.append(event["duration"] - (max(times) - min(times)))
-            latency.append(event["time"] - started[event["task"]] - event["duration"])
-    return {"worker_ms": 1000 * statistics.mean(worker), "latency_ms": 1000 * statistics.mean(latency),
-            "tasks": len(worker)}
+            extra.append(event["duration"] - (max(times) - min(times)))
+    return statistics.mean(extra)
+
+
+def chain(base: Path, length: int = 6) -> Path:
+    """A chain of packages that compile nothing, each on the one before: built on the cluster, one at a
+    time, nothing waits in a queue."""
+    if base.exists():
+        shutil.rmtree(base)
+    previous = ""
+    for index in range(length):
+        name = f"link_{index}_{uuid.uuid4().hex[:6]}"
+        folder = base / "src" / name
+        folder.mkdir(parents=True)
+        depend = f"<depend>{previous}</depend>" if previous else ""
+        (folder / "package.xml").write_text(
+            f'<?xml version="1.0"?><package format="3"><name>{name}</name><version>0.0.1</version><description>'
+            f'd</description><maintainer email="roc@example.com">roc</maintainer><license>Apache-2.0</license>'
+            f"{depend}<export><build_type>cmake</build_type></export></package>")
+        (folder / "CMakeLists.txt").write_text(f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n"
+                                               f"install(FILES package.xml DESTINATION share/{name})\n")
+        previous = name
+    return base
+
+
+def latency(ws: Path) -> float:
+    """Per task of a chain, the client's time beyond the worker's (sending it, the result's return,
+    restoring it here), in seconds: the median."""
+    started = {}
+    gaps = []
+    for event in _events(ws):
+        if event["event"] == "TaskStarted":
+            started[event["task"]] = event["time"]
+        elif event["event"] == "TaskFinished" and event.get("worker"):
+            gaps.append(event["time"] - started[event["task"]] - event["duration"])
+    return statistics.median(gaps)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -128,9 +170,9 @@ def main(argv: list[str] | None = None) -> int:
                 cache = f"http://127.0.0.1:{port}"
                 local, local_ws = build(source, "local", ["taskset", "-c", "0", str(BIN / "roc"), "work", "build",
                                                           "--parallel-workers", "1", "-j", "1"])
-                one, one_ws = cluster_build(source, "one", address, cache, 1, env)
-                two, _ = cluster_build(source, "two", address, cache, 2, env)
-                overheads = task_overheads(one_ws)
+                one, one_ws, between = cluster_build(source, "one", address, cache, 1, env, probe=True)
+                two, _, _ = cluster_build(source, "two", address, cache, 2, env)
+                overheads = {"worker_ms": 1000 * worker_overhead(one_ws), "latency_ms": 1000 * (between or 0.0)}
                 rows.append({"local": local, "one": one, "two": two, **overheads})
                 print(f"  2 workers / 1 worker: {two / one:.2f}x (goal <= 0.6x); 1 worker / local: "
                       f"{one / local:.2f}x (goal <= 1.15x); per task {overheads['worker_ms']:.0f} ms on the worker "

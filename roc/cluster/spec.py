@@ -33,6 +33,7 @@ class PackageWork:
 @dataclass(frozen=True)
 class WorkResult:
     ok: bool
+    key: str  # the package's remote key (what a build uploaded is under it)
     worker: str
     duration: float  # seconds on the worker, restores and upload included
     events: list[Event] = field(default_factory=list)  # the commands, their output and warnings, in order

@@ -113,8 +113,8 @@ class _Work:
             result = {"ok": False, "reason": f"on worker {self.name}: {error.strerror or error}{where}"}
         finally:
             finished.set()
-        return WorkResult(worker=self.name, duration=time.monotonic() - start, events=self.recorder.events,
-                          **result)
+        return WorkResult(key=self.work.key, worker=self.name, duration=time.monotonic() - start,
+                          events=self.recorder.events, **result)
 
     def _watch_cancel(self, finished: threading.Event) -> None:
         """Stop the work when the scheduler released its task (the client cancelled it, or is gone)."""

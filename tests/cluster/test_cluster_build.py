@@ -277,6 +277,17 @@ def test_symlink_install_builds_here_and_says_why(servers, tmp_path):
     assert "Finished <<< linked [" in result.stdout and " on worker-" not in result.stdout
 
 
+def test_a_package_built_without_the_remote_cache_is_tested_here(servers, tmp_path):
+    ws = tmp_path / "unkeyed"
+    _data_package(ws, "unkeyed")
+    assert roc("work", "build", cwd=ws).returncode == 0  # no remote cache: no remote key
+    tested = roc("work", "test", "--cluster", servers[0], "--remote-cache", servers[1], cwd=ws, env=servers[2])
+    assert tested.returncode == 0, tested.stdout + tested.stderr
+    assert ("roc: warning: unkeyed: tested here, not on the cluster: unkeyed has no remote key (build with "
+            "--remote-cache or --cluster first)") in tested.stderr
+    assert "Finished <<< unkeyed [" in tested.stdout and " on worker-" not in tested.stdout
+
+
 def test_a_package_bound_to_its_build_path_is_built_here(servers, tmp_path):
     """A package whose installed file holds the absolute path it was built at (a path no rewrite
     knows) cannot be restored at the client's path: built on a worker, then here, saying why."""
