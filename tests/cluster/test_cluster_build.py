@@ -32,7 +32,7 @@ from cluster_servers import (
 )
 from remote_servers import free_port, webdav
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("cluster")]  # one worker: one cluster for the module
 
 PACKAGES = {"dia_a", "dia_b", "dia_c", "dia_d"}
 RUN_ALL = "dia_a_hello; dia_b_app; install/dia_c/lib/dia_c/dia_c_hello; dia_d_app"
