@@ -19,7 +19,8 @@ import time
 from pathlib import Path
 
 from roc.builder.artefact import Places, installed_files, path_dependent_file
-from roc.builder.state import read_state, write_state
+from roc.builder.layout import package_prefix
+from roc.builder.state import install_intact, read_state, write_state
 from roc.buildtypes.context import BuildOptions
 from roc.cluster.files import RESULT_FILES, pack_files, remove_path, unpack_files
 from roc.cluster.spec import PackageWork, WorkResult
@@ -104,8 +105,8 @@ class _Work:
                 raise WorkFailed(f"worker {self.name} was not started for roc (roc work worker, or dask worker "
                                  "--preload roc.cluster.worker)", refused=True)
             self._check_toolchain(root)
-            with root.attempt(self.work.key, reuse=test) as folder:
-                result = self._test(folder) if test else self._build(root, folder)
+            with root.slot(self.work.name) as folder:
+                result = self._test(folder) if test else self._build(folder)
         except WorkFailed as error:
             result = {"ok": False, "reason": str(error), "refused": error.refused}
         except OSError as error:  # a full disk, a folder it may not write
@@ -138,6 +139,7 @@ class _Work:
         """A workspace in ``folder`` with the package's sources and its dependencies restored."""
         work = self.work
         packages = [_package(data) for data, _ in work.dependencies] + [_package(work.package)]
+        remove_path(folder / "src" / work.name)  # the sources of an earlier task on this package
         unpack_files(work.sources, folder / "src" / work.name)
         workspace = Workspace(folder, packages, {work.name})
         slots = max(1, int(self.worker.state.total_resources.get(BUILD_RESOURCE, 1)))
@@ -153,8 +155,9 @@ class _Work:
 
     def _restore(self, remote: RemoteCache, package: Package, key: str, options: BuildOptions) -> None:
         build_dir = options.build_base / package.name
-        if read_state(build_dir).get("remote_key") == key:
-            return  # restored into this folder before (a test task on the folder of a build)
+        prefix = package_prefix(options.install_base, package.name, options.merge_install)
+        if read_state(build_dir).get("remote_key") == key and install_intact(prefix, package.name, build_dir):
+            return  # restored (or built) in this workspace by an earlier task
         context = TaskContext(package.name, self.recorder, "build")
         missed = remote.restore(package, key, context)
         if missed is not None:
@@ -165,11 +168,10 @@ class _Work:
 
     # ----------------------------------------------------------------------------------- a build
 
-    def _build(self, root: WorkRoot, folder: Path) -> dict:
+    def _build(self, folder: Path) -> dict:
         from roc.builder.plan import plan_build
         from roc.engine.jobserver import Jobserver
 
-        work = self.work
         workspace, options, remote = self._workspace(folder)
         compiler = self._compiler_cache(folder, options, remote)
         jobserver = Jobserver(options.jobs)
@@ -187,22 +189,28 @@ class _Work:
             return {"ok": False, "reason": self.recorder.failures[-1]}
         if self.stop.is_set():
             return {"ok": False, "reason": "cancelled"}
-        if remote.unavailable:
-            raise WorkFailed(f"worker {self.name} could not upload it: remote cache {remote.settings.shown}: "
-                             f"{remote.unavailable}")
-        root.succeeded(work.key, folder)
+        return self._check_upload(workspace, options, remote)
+
+    def _check_upload(self, workspace: Workspace, options: BuildOptions, remote: RemoteCache) -> dict:
+        """The package is in the remote cache under its key (uploaded now if it was up to date here, built
+        by an earlier task, and its entry has gone since), or its files hold this folder's path."""
         from roc.remote_cache.store import StoreUnavailable
 
+        key, name, places = self.work.key, self.work.name, remote.places
         try:
-            uploaded = remote.store().exists(f"ac/{work.key}")
+            uploaded = remote.unavailable is None and remote.store().exists(f"ac/{key}")
+            if not uploaded and remote.unavailable is None:
+                bound = path_dependent_file(installed_files(name, places, options.merge_install),
+                                            places.install_base, places)
+                if bound:  # uploaded under the key placed at this folder
+                    return {"ok": True, "bound": bound}
+                remote.upload(workspace.by_name[name], key, TaskContext(name, self.recorder))
+                uploaded = remote.unavailable is None and remote.store().exists(f"ac/{key}")
         except StoreUnavailable as error:
-            raise WorkFailed(f"worker {self.name} could not check its upload: remote cache {remote.settings.shown}: "
-                             f"{error}") from None
-        if not uploaded:  # uploaded under the key placed at this folder: its files hold this path
-            places = remote.places
-            bound = path_dependent_file(installed_files(work.name, places, options.merge_install),
-                                        places.install_base, places)
-            return {"ok": True, "bound": bound or "its archive was not uploaded"}
+            remote.unavailable = str(error)
+        if not uploaded:
+            raise WorkFailed(f"worker {self.name} could not upload it: remote cache {remote.settings.shown}: "
+                             f"{remote.unavailable or 'the entry is not there'}")
         return {"ok": True}
 
     def _expect_key(self, tasks) -> list[str]:

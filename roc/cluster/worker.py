@@ -25,12 +25,10 @@ logger = logging.getLogger("distributed.worker")
 @click.option("--roc-root", type=click.Path(file_okay=False),
               help="the folder this worker builds in (a workspace per task below it; default: roc/ in the "
                    "worker's own local directory, which Dask removes when the worker stops)")
-@click.option("--roc-keep", default=4, show_default=True, type=int,
-              help="build folders kept for the test tasks of the same packages")
-def dask_setup(worker, roc_root: str | None, roc_keep: int) -> None:
+def dask_setup(worker, roc_root: str | None) -> None:
     root = Path(roc_root).absolute() if roc_root else Path(worker.local_directory) / "roc"
     root.mkdir(parents=True, exist_ok=True)
-    worker.roc_work_root = WorkRoot(root, keep=roc_keep)
+    worker.roc_work_root = WorkRoot(root)
     state = worker.state
     slots = state.total_resources.get(BUILD_RESOURCE, 1)
     digest = machine_fingerprint(root)

@@ -1,11 +1,12 @@
-"""A worker's work root (``roc work worker --root DIR``): one folder per task attempt, below it a
-workspace of its own (``src/``, ``build/``, ``install/``) at a path no client has.
+"""A worker's work root (``roc work worker --root DIR``): workspaces of its own (``slots/N/`` with
+``src/``, ``build/`` and ``install/``) at paths no client has, one per package the worker builds at
+once.
 
-Each attempt gets a new folder, locked while its task runs: a task that runs again after its worker
-was killed never meets the commands the killed one left running. A folder whose build succeeded is
-remembered under its remote key, so that a test task of the same package on this worker uses its
-build tree (CTest needs one). Unlocked folders beyond the ``keep`` newest builds are removed when a
-task starts.
+A slot is kept from task to task, as a developer's workspace is: a dependency restored there stays
+(restored again only when its remote key changes), and a package built there keeps its build tree (a
+rebuild is incremental; its test task finds it). Each task locks its slot. A task that dies with its
+worker (SIGKILL) leaves a marker naming its package: the next task in the slot first stops the
+commands still running there and removes that package's half-built build and install folders.
 """
 
 from __future__ import annotations
@@ -14,67 +15,65 @@ import contextlib
 import fcntl
 import os
 import shutil
-import tempfile
-import threading
 from collections.abc import Iterator
 from pathlib import Path
 
 from roc.fsutil import write_text_atomic
 
-LOCK = ".roc-lock"
+LOCK, BUSY = ".roc-lock", ".roc-busy"
 
 
 class WorkRoot:
-    def __init__(self, root: Path, keep: int = 4):
-        self.root, self.keep = root, keep
-        self.work, self.done = root / "work", root / "done"
-        self._mutex = threading.Lock()  # a folder is locked before another thread of the worker tidies
+    def __init__(self, root: Path):
+        self.root = root
 
     @contextlib.contextmanager
-    def attempt(self, key: str, reuse: bool = False) -> Iterator[Path]:
-        """A locked folder for one task on the package with remote key ``key``: with ``reuse``, the one
-        of the last successful build of that key here, when no other task holds it."""
-        with self._mutex:
-            self.work.mkdir(parents=True, exist_ok=True)
-            self.done.mkdir(parents=True, exist_ok=True)
-            self._tidy()
-            folder = self._done_folder(key) if reuse else None
-            lock = _try_lock(folder) if folder is not None else None
-            if lock is None:
-                folder = Path(tempfile.mkdtemp(prefix=f"{key[:16]}-", dir=self.work))
-                lock = _try_lock(folder)
-        assert folder is not None and lock is not None
+    def slot(self, package: str) -> Iterator[Path]:
+        """A free workspace, locked, for one task on ``package``."""
+        index = 0
+        while True:
+            folder = self.root / "slots" / str(index)
+            folder.mkdir(parents=True, exist_ok=True)
+            lock = _try_lock(folder)
+            if lock is not None:
+                break
+            index += 1
         try:
+            _recover(folder)
+            write_text_atomic(folder / BUSY, package)
             yield folder
+            (folder / BUSY).unlink(missing_ok=True)
         finally:
             os.close(lock)
 
-    def succeeded(self, key: str, folder: Path) -> None:
-        """``folder`` holds a whole build of ``key``."""
-        write_text_atomic(self.done / key[:16], folder.name)
 
-    def _done_folder(self, key: str) -> Path | None:
-        try:
-            folder = self.work / (self.done / key[:16]).read_text().strip()
-        except OSError:
-            return None
-        return folder if folder.is_dir() else None
+def _recover(folder: Path) -> None:
+    """After a task that died in ``folder``: stop what it left running, remove what it half made."""
+    try:
+        package = (folder / BUSY).read_text().strip()
+    except OSError:
+        return
+    stop_processes_in(folder)
+    for half_made in (folder / "build" / package, folder / "install" / package):
+        shutil.rmtree(half_made, ignore_errors=True)
+    (folder / BUSY).unlink(missing_ok=True)
 
-    def _tidy(self) -> None:
-        kept = sorted(self.done.iterdir(), key=lambda p: p.stat().st_mtime, reverse=True)
-        keep = set()
-        for pointer in kept[self.keep:]:
-            pointer.unlink(missing_ok=True)
-        for pointer in kept[:self.keep]:
-            with contextlib.suppress(OSError):
-                keep.add(pointer.read_text().strip())
-        for folder in self.work.iterdir():
-            if folder.name in keep or not folder.is_dir():
-                continue
-            lock = _try_lock(folder)
-            if lock is not None:  # no task uses it
-                shutil.rmtree(folder, ignore_errors=True)
-                os.close(lock)
+
+def stop_processes_in(folder: Path) -> None:
+    """Kill every process working in ``folder`` (its working directory there): the commands a killed
+    worker could not stop."""
+    import psutil
+
+    inside = str(folder) + os.sep
+    found = []
+    for process in psutil.process_iter():
+        with contextlib.suppress(psutil.Error):
+            if (process.cwd() + os.sep).startswith(inside):
+                found.append(process)
+    for process in found:
+        with contextlib.suppress(psutil.Error):
+            process.kill()
+    psutil.wait_procs(found, timeout=10)
 
 
 def _try_lock(folder: Path) -> int | None:

@@ -98,22 +98,28 @@ def test_files_keep_content_and_modes_and_refuse_escapes(tmp_path):
     assert not (tmp_path / "escaped").exists()
 
 
-def test_work_root_gives_each_attempt_a_locked_folder_and_reuses_a_build(tmp_path):
-    root = WorkRoot(tmp_path / "root", keep=1)
-    key = "ab" * 32
-    with root.attempt(key) as first, root.attempt(key) as second:
-        assert first != second  # a task run again never meets the folder of one still running
-        (first / "marker").write_text("built")
-    root.succeeded(key, first)
-    with root.attempt(key, reuse=True) as again:
-        assert again == first and (again / "marker").is_file()
-        with root.attempt(key, reuse=True) as busy:  # held: a new folder
-            assert busy != first
-    with root.attempt("cd" * 32) as other:
-        assert first.is_dir() and not second.exists()  # the kept build stays, unlocked leftovers go
-        root.succeeded("cd" * 32, other)
-    with root.attempt("ef" * 32):
-        assert not first.exists()  # beyond keep=1
+def test_work_root_slots_are_kept_locked_and_recovered(tmp_path):
+    root = WorkRoot(tmp_path / "root")
+    with root.slot("a") as first:
+        with root.slot("b") as second:
+            assert first != second  # one workspace per task at once
+        (first / "install" / "a").mkdir(parents=True)
+        (first / "install" / "kept").mkdir()
+    with root.slot("c") as again:
+        assert again == first and (again / "install" / "a").is_dir()  # kept from task to task
+    # a task that died with its worker: its commands still run in the slot, its package half made
+    (first / "build" / "d").mkdir(parents=True)
+    (first / ".roc-busy").write_text("d")
+    leftover = subprocess.Popen(["sleep", "60"], cwd=first / "build" / "d")
+    try:
+        with root.slot("e") as recovered:
+            assert recovered == first
+            leftover.wait(timeout=10)  # killed (it would sleep 60 s): TimeoutExpired otherwise
+            assert not (first / "build" / "d").exists() and (first / "install" / "kept").is_dir()
+    finally:
+        if leftover.poll() is None:
+            leftover.kill()
+            leftover.wait()
 
 
 def test_work_elsewhere_finishes_with_its_worker_and_duration():
