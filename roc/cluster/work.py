@@ -13,6 +13,7 @@ the running commands' whole process trees.
 
 from __future__ import annotations
 
+import logging
 import os
 import threading
 import time
@@ -99,6 +100,7 @@ class _Work:
         start = time.monotonic()
         finished = threading.Event()
         threading.Thread(target=self._watch_cancel, args=(finished,), daemon=True).start()
+        result: dict = {"ok": False, "reason": f"worker {self.name} gave no result"}
         try:
             root = getattr(self.worker, "roc_work_root", None)
             if not isinstance(root, WorkRoot):
@@ -112,6 +114,9 @@ class _Work:
         except OSError as error:  # a full disk, a folder it may not write
             where = f" ({error.filename})" if error.filename else ""
             result = {"ok": False, "reason": f"on worker {self.name}: {error.strerror or error}{where}"}
+        except Exception as error:  # noqa: BLE001 - a bug: the package fails with it, its traceback in the worker's log
+            logging.getLogger("distributed.worker").exception("roc: %s failed", self.work.name)
+            result = {"ok": False, "reason": f"worker {self.name}: internal error: {type(error).__name__}: {error}"}
         finally:
             finished.set()
         return WorkResult(key=self.work.key, worker=self.name, duration=time.monotonic() - start,
