@@ -65,6 +65,7 @@ class TaskFinished(Event):
     duration: float = 0.0
     cached: bool = False  # skipped because it was up to date
     restored: bool = False  # not run: its result was fetched from a cache (after a TaskRestoring)
+    worker: str = ""  # the cluster worker that ran it (roc work build --cluster); empty: it ran here
 
 
 @dataclass(frozen=True)
