@@ -86,3 +86,31 @@ def test_ros_distro_conditions_see_the_detected_distribution(tmp_path: Path) -> 
                             env=env, capture_output=True, text=True, timeout=60)
     assert listed.returncode == 0, listed.stderr
     assert sorted(listed.stdout.split()) == ["app", f"on_{DISTRO}"]
+
+
+KEYED = """module keyed_msgs {
+  module msg {
+    struct Pair {
+      @key string name;
+      double value;
+    };
+  };
+};
+"""
+
+
+def test_an_interface_defined_in_idl_only_is_shown_as_written(tmp_path: Path) -> None:
+    """Kilted's wheels have the first ones (test_msgs' keyed types): no .msg, an IDL module with @key."""
+    prefix = tmp_path / "prefix"
+    (prefix / "share" / "ament_index" / "resource_index" / "packages").mkdir(parents=True)
+    (prefix / "share" / "ament_index" / "resource_index" / "packages" / "keyed_msgs").touch()
+    (prefix / "share" / "keyed_msgs" / "msg").mkdir(parents=True)
+    (prefix / "share" / "keyed_msgs" / "msg" / "Pair.idl").write_text(KEYED)
+    env = ros_env(AMENT_PREFIX_PATH=f"{prefix}:{sys.prefix}")
+    shown = subprocess.run([str(BIN / "roc"), "interface", "show", "keyed_msgs/msg/Pair"], env=env,
+                           capture_output=True, text=True, timeout=60)
+    assert (shown.returncode, shown.stdout, shown.stderr) == (0, KEYED, "")
+    if DISTRO != "jazzy":
+        kilted = subprocess.run([str(BIN / "roc"), "interface", "show", "test_msgs/msg/KeyedString"], env=env,
+                                capture_output=True, text=True, timeout=60)
+        assert kilted.returncode == 0 and "      @key string key;\n" in kilted.stdout, kilted.stderr
