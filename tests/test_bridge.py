@@ -75,6 +75,7 @@ def _stop(process: subprocess.Popen) -> int:
         stop_process(process)
 
 
+@pytest.mark.distro
 def test_topics_arrive_in_the_other_domain_with_their_qos(domains) -> None:
     a, b = domains
     bridge = _bridge("--from-domain", a["ROS_DOMAIN_ID"], "--to-domain", b["ROS_DOMAIN_ID"], "/chatter", "latched",
