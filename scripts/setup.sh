@@ -37,8 +37,11 @@ case "${1:-}" in
     *) die "unknown argument '$1' (usage: bash scripts/setup.sh [--distro jazzy|kilted])" ;;
 esac
 [ "$#" -eq 0 ] || die "unknown argument '$1' (usage: bash scripts/setup.sh [--distro jazzy|kilted])"
+case "$DISTRO" in
+    jazzy|kilted) ;;
+    *) die "roc is set up for the ROS 2 distributions jazzy and kilted, not '$DISTRO'" ;;
+esac
 REQUIREMENTS="$ROOT/requirements/ros-$DISTRO.txt"
-[ -f "$REQUIREMENTS" ] || die "no ROS 2 distribution '$DISTRO' here (requirements/ros-$DISTRO.txt); choose jazzy or kilted"
 # Jazzy, the default, in .venv; any other distribution in a venv of its own
 if [ "$DISTRO" = jazzy ]; then VENV="$ROOT/.venv"; else VENV="$ROOT/.venv-$DISTRO"; fi
 VPY="$VENV/bin/python"

@@ -15,9 +15,11 @@ import signal
 from collections import Counter
 
 import pytest
-from build_helpers import DISTRO
+
+from roc import distribution
 
 FULL_SUITE_DISTRO = "jazzy"
+DISTRO = distribution.current({}).name  # the venv's (tests/build_helpers.py: DISTRO)
 
 if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
