@@ -92,7 +92,6 @@ def test_frame_verbs_work_in_the_sourced_example(example):
                                              "- Rotation: in Quaternion (xyzw) [0.000, 0.000, 0.707, 0.707]"]
 
 
-@pytest.mark.distro
 @pytest.mark.colcon
 def test_same_install_tree_and_environment_as_colcon(example, tmp_path):
     theirs = tmp_path / "colcon"

@@ -85,7 +85,6 @@ def test_usage_error_exits_2(demo):
     assert got.returncode == 2
 
 
-@pytest.mark.distro
 def test_json_shapes(demo):
     topics = json.loads(roc("topic", "list", "--format", "json", env=demo).stdout)
     chatter = next(t for t in topics if t["name"] == "/chatter")
@@ -117,7 +116,6 @@ EVERY_GRAPH_VERB = [
 ]
 
 
-@pytest.mark.distro
 @pytest.mark.parametrize("command", EVERY_GRAPH_VERB, ids=" ".join)
 def test_every_verb_prints_json(demo, command):
     got = roc(*command, "--format", "json", env=demo)
