@@ -27,13 +27,9 @@ class Distribution:
     """A ROS 2 distribution and the facts about it that roc acts on."""
 
     name: str
-    fastdds_major: int  # 2: Fast DDS 2 (the libfastrtps library), 3: Fast DDS 3 (libfastdds)
-    # the variable Fast DDS reads its XML profiles file from (Fast DDS 3 dropped the FASTRTPS_ names)
+    fastdds_major: int  # 2: Fast DDS 2 (Jazzy's libfastrtps), 3: Fast DDS 3 (Kilted's libfastdds)
+    # the variable Fast DDS reads its XML profiles file from (Kilted's rmw warns about Fast DDS 2's)
     profiles_variable: str
-
-    @property
-    def fastdds_library(self) -> str:
-        return "libfastrtps.so" if self.fastdds_major == 2 else "libfastdds.so"
 
 
 JAZZY = Distribution("jazzy", fastdds_major=2, profiles_variable="FASTRTPS_DEFAULT_PROFILES_FILE")

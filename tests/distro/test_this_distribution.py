@@ -15,9 +15,8 @@ from build_helpers import BIN, DISTRO, REQUIREMENTS, ros_domain_id, ros_env
 
 from roc import distribution
 
-pytestmark = pytest.mark.distro
 
-
+@pytest.mark.distro
 def test_the_distribution_is_read_from_the_venvs_rclpy() -> None:
     found = distribution.detected({"AMENT_PREFIX_PATH": sys.prefix})
     assert found is not None and found[0] == DISTRO == REQUIREMENTS.stem.removeprefix("ros-")
@@ -27,6 +26,7 @@ def test_the_distribution_is_read_from_the_venvs_rclpy() -> None:
     assert distribution.mix({"AMENT_PREFIX_PATH": sys.prefix, "ROS_DISTRO": "humble"}).startswith("humble (ROS_DISTRO)")
 
 
+@pytest.mark.distro
 def test_doctor_reports_the_distribution(tmp_path: Path) -> None:
     done = subprocess.run([str(BIN / "roc"), "doctor", "--no-daemon", "--spin-time", "0.5", "--format", "json"],
                           env=ros_env(ROS_DOMAIN_ID=ros_domain_id(50), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
@@ -44,6 +44,7 @@ graph.close()
 """
 
 
+@pytest.mark.distro
 def test_roc_s_participants_load_its_fast_dds_profile_without_a_complaint(tmp_path: Path) -> None:
     """Fast DDS 3 (Kilted) rejects a profile file with Fast DDS 2's element names (Jazzy's), and Kilted's rmw
     warns about Fast DDS 2's variable: either one prints on stderr and loses roc's settings."""
@@ -58,6 +59,7 @@ def test_roc_s_participants_load_its_fast_dds_profile_without_a_complaint(tmp_pa
     assert "<leaseAnnouncement><sec>0</sec><nanosec>500000000</nanosec></leaseAnnouncement>" in profile.read_text()
 
 
+@pytest.mark.distro
 def test_the_fork_server_preloads_every_type_a_node_loads() -> None:
     """roc launch's warm start: rclpy and the type support of every built-in endpoint of a node."""
     probe = ("from roc.launch import forkserver as f; "
@@ -72,6 +74,7 @@ MANIFEST = """<?xml version="1.0"?><package format="3"><name>{name}</name><versi
 {depends}<export><build_type>cmake</build_type></export></package>"""
 
 
+@pytest.mark.distro
 def test_ros_distro_conditions_see_the_detected_distribution(tmp_path: Path) -> None:
     """ROS 2 from wheels sets no ROS_DISTRO: roc fills in the one it detects, as a sourced ROS 2 would."""
     for name in ("on_jazzy", "on_kilted"):
@@ -99,6 +102,7 @@ KEYED = """module keyed_msgs {
 """
 
 
+@pytest.mark.distro
 def test_an_interface_defined_in_idl_only_is_shown_as_written(tmp_path: Path) -> None:
     """Kilted's wheels have the first ones (test_msgs' keyed types): no .msg, an IDL module with @key."""
     prefix = tmp_path / "prefix"
@@ -114,3 +118,12 @@ def test_an_interface_defined_in_idl_only_is_shown_as_written(tmp_path: Path) ->
         kilted = subprocess.run([str(BIN / "roc"), "interface", "show", "test_msgs/msg/KeyedString"], env=env,
                                 capture_output=True, text=True, timeout=60)
         assert kilted.returncode == 0 and "      @key string key;\n" in kilted.stdout, kilted.stderr
+
+
+def test_every_distribution_gets_its_facts() -> None:
+    """Pure logic (runs on Jazzy only): older distributions take Jazzy's facts, newer ones Kilted's."""
+    assert distribution.named("kilted").fastdds_major == 3 and distribution.named("jazzy").fastdds_major == 2
+    assert distribution.named("humble").fastdds_major == 2 and distribution.named("lyrical").fastdds_major == 3
+    assert distribution.named("lyrical").name == "lyrical"
+    assert [distribution.of_rclpy(v) for v in ("7.1.5", "9.1.2", "3.3.16", "42.0.0", "x")] == [
+        "jazzy", "kilted", "humble", None, None]
