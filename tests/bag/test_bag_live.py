@@ -98,6 +98,7 @@ def play_when_recorder_listens(bag: Path, recorder: subprocess.Popen, topics: li
         stop_process(player)
 
 
+@pytest.mark.distro
 def test_record_play_record_round_trip_of_every_test_msgs_type(tmp_path):
     env = graph_env(32, tmp_path)
     topics = [f"/{name.lower()}" for name in TEST_MSGS]

@@ -68,6 +68,7 @@ def test_lifecycle_list_all_is_the_whole_transition_graph(managed):
                                                           "\tGoal: finalized\n")
 
 
+@pytest.mark.distro
 def test_lifecycle_set_walks_a_node_through_its_states(managed):
     env = managed
     configured = roc("lifecycle", "set", "/arm", "configure", env=env)

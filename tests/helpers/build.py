@@ -8,12 +8,17 @@ import subprocess
 import sys
 from pathlib import Path
 
+from roc import distribution
+
 REPO = Path(__file__).resolve().parents[2]
 FIXTURES = REPO / "workspaces" / "fixtures"
 TESTS = REPO / "tests"
 NODES = TESTS / "nodes"  # the scripts the tests run as ROS nodes
 DATA = TESTS / "data"
 BIN = Path(sys.executable).parent
+# The ROS 2 distribution of the venv that runs the tests (scripts/setup.sh: .venv Jazzy, .venv-kilted Kilted)
+DISTRO = distribution.current({}).name
+REQUIREMENTS = REPO / "requirements" / f"ros-{DISTRO}.txt"  # its wheels, as scripts/setup.sh installed them
 ENV_VARIABLES = ("AMENT_PREFIX_PATH", "CMAKE_PREFIX_PATH", "PYTHONPATH", "PATH", "LD_LIBRARY_PATH",
                  "COLCON_PREFIX_PATH")
 

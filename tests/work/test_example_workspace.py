@@ -34,6 +34,7 @@ def example(tmp_path_factory):
     return ws
 
 
+@pytest.mark.distro
 def test_cpp_executables_and_interfaces(example):
     ran = in_sourced_shell(example, "install/demo_tools/lib/demo_tools/filter_demo; demo_plain; "
                                     "python -c 'from demo_interfaces.msg import Reading; "
@@ -52,6 +53,7 @@ def test_powershell_scripts(example):
                           merged=False)
 
 
+@pytest.mark.distro
 def test_python_node_messages_arrive(example):
     env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin", "ROS_DOMAIN_ID": ros_domain_id(5),
            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST", "RMW_IMPLEMENTATION": "rmw_fastrtps_cpp"}

@@ -42,6 +42,7 @@ def _reasons(stdout: str) -> dict[str, list[str]]:
     return {e["task"]: e["reasons"] for e in events if e["event"] == "TaskStarted"}
 
 
+@pytest.mark.distro
 def test_results_equal_colcon_and_are_cached(tmp_path: Path) -> None:
     workspace = copy_fixture("testing", tmp_path / "ws")
     built = roc("work", "build", cwd=workspace)

@@ -253,7 +253,7 @@ def _locked_build(args, workspace, options, switches: dict[str, bool], remote, e
                   stop: threading.Event | None = None) -> int:
     """Build under the build base's lock. ``extra_handlers`` (roc tui's board and summary) replace the
     console; ``stop`` ends the run as Ctrl+C does."""
-    from roc.builder.layout import prepare_build_base, prepare_install_base
+    from roc.builder.layout import prepare_build_base, prepare_distribution, prepare_install_base
     from roc.builder.lock import build_lock
 
     compiler = None
@@ -266,6 +266,7 @@ def _locked_build(args, workspace, options, switches: dict[str, bool], remote, e
     try:
         with build_lock(options.build_base):
             prepare_build_base(options.build_base)
+            prepare_distribution(options.build_base, options.install_base)
             prepare_install_base(options.install_base, args.merge_install)
             return _build(args, workspace, options, switches, remote, compiler, extra_handlers, stop, cluster)
     finally:
