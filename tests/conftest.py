@@ -62,3 +62,18 @@ def launch_demo_prefix(tmp_path_factory):
     from helpers.launch import build_demo
 
     return build_demo(tmp_path_factory.mktemp("launch_demo"))
+
+
+@pytest.fixture(scope="session")
+def example_workspace(tmp_path_factory):
+    """workspaces/example built by roc once per test worker (its tests and the manual's live examples share
+    it: mark them ``xdist_group("example_workspace")`` to build it once). Read it, never change it."""
+    import shutil
+
+    from helpers.build import REPO, roc
+
+    workspace = tmp_path_factory.mktemp("example")
+    shutil.copytree(REPO / "workspaces" / "example" / "src", workspace / "src")
+    result = roc("work", "build", "--parallel-workers", "2", cwd=workspace)
+    assert result.returncode == 0, result.stdout + result.stderr
+    return workspace

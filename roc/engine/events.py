@@ -105,6 +105,15 @@ class TestFailures(Event):
 
 
 @dataclass(frozen=True)
+class TestsNotRun(Event):
+    """A test task's tool ran no test (pytest collected none); the task still finishes, as in colcon.
+    ``reason``: why, e.g. the test files that skipped themselves while pytest imported them."""
+
+    __test__ = False
+    reason: str = ""
+
+
+@dataclass(frozen=True)
 class ProbeResult(Event):
     """A probe's verdict (``pass``, ``fail``, ``error``), sent before its task ends: what it found
     (``message``, ``measured``) and what was expected."""

@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 import threading
 import time
-from collections.abc import Mapping, MutableMapping
+from collections.abc import Mapping, MutableMapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -140,18 +140,22 @@ class Graph:
     BRIDGE_PROFILE for a bridge's. Both announce the participant every 0.5 s."""
 
     def __init__(self, node_name: str | None = None, domain_id: int | None = None, events: bool = False,
-                 profile: Path = PARTICIPANT_PROFILE) -> None:
+                 profile: Path = PARTICIPANT_PROFILE, arguments: Sequence[str] = ()) -> None:
         """``events``: spin with rclpy's C++ EventsExecutor, which takes a message in a fraction of the
         Python executor's time (at 5 kHz: no loss and 0.2 ms instead of 10 % loss and 60 ms here). In
         rclpy 7.1.6 it never calls a callback that takes message info, so echo and hz take their
-        messages with roc.ros.raw_subscription instead."""
+        messages with roc.ros.raw_subscription instead.
+
+        ``arguments``: the node's ROS arguments (``--ros-args --remap OLD:=NEW``, as rosbag2 gives its
+        player's). rcl never reads roc's own command line, where it would take any ``NAME:=VALUE`` word
+        for a remapping rule (and warn that this syntax is deprecated)."""
         use_profile(profile)
         self.context = Context()
-        rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO, domain_id=domain_id)
+        rclpy.init(args=[], context=self.context, signal_handler_options=SignalHandlerOptions.NO, domain_id=domain_id)
         # roc's own node shows as little as it can, to other tools too: no parameter, type description
         # or /rosout endpoints, and no /parameter_events publisher (its parameters never change)
         self.node = Node(node_name or own_node_name(os.getpid()), context=self.context, start_parameter_services=False,
-                         enable_rosout=False,
+                         enable_rosout=False, cli_args=list(arguments),
                          parameter_overrides=[Parameter("start_type_description_service", value=False)])
         for publisher in list(self.node.publishers):
             if publisher.topic_name == "/parameter_events":

@@ -100,6 +100,23 @@ def threads(process: subprocess.Popen) -> list[tuple[str, Path]]:
     return [(task.joinpath("comm").read_text().strip(), task) for task in Path(f"/proc/{process.pid}/task").iterdir()]
 
 
+def component_prefix(root: Path) -> Path:
+    """An install prefix registering demo_components' two components and rclcpp_components' container
+    executable (tests/nodes/container_node.py), as an rclcpp install would."""
+    index = root / "share" / "ament_index" / "resource_index"
+    for package in ("demo_components", "rclcpp_components", "no_components"):
+        (index / "packages").mkdir(parents=True, exist_ok=True)
+        (index / "packages" / package).write_text("")
+    (index / "rclcpp_components").mkdir(exist_ok=True)
+    (index / "rclcpp_components" / "demo_components").write_text(
+        "demo_components::Talker;lib/libtalker.so\ndemo_components::Listener;lib/liblistener.so\n")
+    container = root / "lib" / "rclcpp_components" / "component_container"
+    container.parent.mkdir(parents=True, exist_ok=True)
+    container.write_text(f"#!/bin/sh\nexec {sys.executable} {NODE_SCRIPT.with_name('container_node.py')} \"$@\"\n")
+    container.chmod(0o755)
+    return root
+
+
 def stop_all(processes: list[subprocess.Popen]) -> None:
     for process in processes:
         stop_process(process)

@@ -261,3 +261,17 @@ def test_roc_toml_with_launch_systems_still_configures_the_work_verbs(tmp_path: 
     (tmp_path / "roc.toml").write_text(SYSTEM + '\n[build]\nparallel-workers = 3\n')
     config = load_configuration(tmp_path, "build", None, metas=[], ignore_user_meta=True)
     assert config.effective()["parallel-workers"].value == 3
+
+
+@pytest.mark.parametrize("variables", [{"ROS_LOG_DIR": "/tmp/roc-logs/../roc-logs2"}, {"ROS_LOG_DIR": "~/logs"},
+                                       {"ROS_HOME": "/tmp/roc-home"}, {"ROS_LOG_DIR": "", "ROS_HOME": ""}, {}])
+def test_the_ros_log_directory_is_the_launch_librarys(variables: dict[str, str], monkeypatch) -> None:
+    """Where ros2 launch writes its logs (roc launch's logs outside a workspace): the launch library's own rule."""
+    logging = pytest.importorskip("launch.logging")
+    from roc.launch.logs import ros_log_directory
+
+    for name in ("ROS_LOG_DIR", "ROS_HOME"):
+        monkeypatch.delenv(name, raising=False)
+    for name, value in variables.items():
+        monkeypatch.setenv(name, value)
+    assert str(ros_log_directory()) == logging._get_logging_directory()

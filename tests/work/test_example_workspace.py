@@ -14,7 +14,6 @@ from helpers.build import (
     comparable_install_files,
     in_sourced_shell,
     package_dsv_files,
-    roc,
     ros_domain_id,
     sourced_values,
     stop_process,
@@ -22,16 +21,12 @@ from helpers.build import (
 )
 from helpers.powershell import check_package_scripts, parse
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("example_workspace")]  # built once for the manual too
 
 
 @pytest.fixture(scope="module")
-def example(tmp_path_factory):
-    ws = tmp_path_factory.mktemp("example")
-    shutil.copytree(REPO / "workspaces" / "example" / "src", ws / "src")
-    result = roc("work", "build", "--parallel-workers", "2", cwd=ws)
-    assert result.returncode == 0, result.stdout + result.stderr
-    return ws
+def example(example_workspace):
+    return example_workspace
 
 
 @pytest.mark.distro

@@ -59,9 +59,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                           "warm interpreter (see the manual's 'Warm start')")
     roc.add_argument("--plain", action="store_true",
                      help="plain lines on a terminal too, without the live status view")
-    roc.add_argument("--log-base", default="log", metavar="DIR",
-                     help="where the run's logs go: DIR/launch_<time>/<process>.log (default: log; "
-                          "/dev/null for none)")
+    roc.add_argument("--log-base", metavar="DIR",
+                     help="where the run's logs go: DIR/launch_<time>/<process>.log (default: log at the workspace "
+                          "root; outside a workspace, where ros2 launch writes its logs: $ROS_LOG_DIR, else "
+                          "$ROS_HOME/log, else ~/.ros/log; /dev/null for none)")
     add_format_argument(parser)
     add_discovery_arguments(parser)
 
@@ -87,10 +88,16 @@ def _run_options(args: argparse.Namespace, title: str):
     check = None
     if args.check is not None:
         check = CheckOptions(args.check, args.exit_after_check, not args.no_daemon, args.spin_time)
-    root = find_workspace_root(Path.cwd()) or Path.cwd()
-    log_base = None if args.log_base == os.devnull else root / args.log_base
+    root = find_workspace_root(Path.cwd())
+    outside = root is None and args.log_base is None  # not into ./log of wherever the user stands: ros2's place
+    if outside:
+        from roc.launch.logs import ros_log_directory
+
+        log_base: Path | None = ros_log_directory()
+    else:
+        log_base = None if args.log_base == os.devnull else (root or Path.cwd()) / (args.log_base or "log")
     view = not args.plain and sys.stdout.isatty() and os.environ.get("TERM") != "dumb"
-    return RunOptions(title, log_base, view, check, args.warm_start)
+    return RunOptions(title, log_base, view, check, args.warm_start, ros_log_layout=outside)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -11,7 +11,7 @@ from roc.cli.options import (
     add_base_arguments,
     add_selection_arguments,
 )
-from roc.engine.events import Event, TestFailures
+from roc.engine.events import Event, TestFailures, TestsNotRun
 from roc.errors import EXIT_FAILURE, EXIT_INTERRUPTED, UsageError
 from roc.handlers import add_event_handlers_argument, handler_switches, output_handlers
 
@@ -54,15 +54,29 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_selection_arguments(parser)
 
 
-class TestFailureKeys:
-    """Which tasks' tests failed (for ``[ with test failures ]`` and the exit code)."""
+class TestOutcomes:
+    """Which tasks' tests failed (for ``[ with test failures ]`` and the exit code), and which ran none
+    and why (``[ no tests ran: ... ]``)."""
+
+    __test__ = False
 
     def __init__(self) -> None:
         self.keys: set[str] = set()
+        self.not_run: dict[str, str] = {}
 
     def __call__(self, event: Event) -> None:
         if isinstance(event, TestFailures):
             self.keys.add(event.key)
+        elif isinstance(event, TestsNotRun):
+            self.not_run[event.key] = event.reason
+
+    def note(self, key: str) -> str:
+        """What the console adds to the task's ``Finished`` line."""
+        if key in self.keys:
+            return "\t[ with test failures ]"
+        if key not in self.not_run:
+            return ""
+        return f"\t[ no tests ran{': ' + self.not_run[key] if self.not_run[key] else ''} ]"
 
 
 def _options(args: argparse.Namespace, root: Path):
@@ -146,10 +160,9 @@ def _test(args: argparse.Namespace, workspace, options, switches: dict[str, bool
         prepare_build_base(options.build_base)
         prepare_install_base(options.install_base, args.merge_install)
         durations = DurationStore(options.build_base / DURATIONS_FILE)
-        failures = TestFailureKeys()
+        failures = TestOutcomes()
         handlers = [*output_handlers(args, switches, workspace.root, options.build_base, verb="test",
-                                     cached_label=CACHED_LABEL, finished_note=lambda key: (
-                                         "\t[ with test failures ]" if key in failures.keys else "")),
+                                     cached_label=CACHED_LABEL, finished_note=failures.note),
                     failures, durations]
         try:
             tasks = plan_tests(workspace, options, durations.durations, force=args.force, use_cache=not args.no_cache,
