@@ -9,6 +9,11 @@ Two facts make the local part exact:
   prefix carries the writer's host id (bytes 2-3) and process id (bytes 4-5, little-endian), so the
   writers seen tell which of those participants have been discovered.
 
+A participant discovered has not necessarily told its nodes yet (its ``ros_discovery_info`` message
+comes after its writer, under load 0.1 s and more later): it is heard once one of its endpoints has a
+node name, or, for roc's own participants (which have no endpoints), once a node named for its process
+is known (``unheard_participants``).
+
 Participants on other hosts (a discovery range beyond this host) cannot be counted: the caller waits
 for the graph to go quiet for them. This module reads /proc and rclpy endpoint infos; it never
 imports rclpy itself (``roc tui`` finds each node's process with it too).
@@ -20,10 +25,13 @@ import os
 from pathlib import Path
 from typing import Any
 
+from roc.ros.protocol import OWN_NODE_PREFIX, is_own_node
+
 PORT_BASE = 7400
 DOMAIN_GAIN = 250
 PARTICIPANT_GAIN = 2
 METATRAFFIC_UNICAST_OFFSET = 10
+UNKNOWN_NODE = "_NODE_NAME_UNKNOWN_"  # rmw_dds_common's name for the node of an endpoint not told yet
 MAX_PARTICIPANT_ID = 119  # the highest id whose ports stay within the domain's 250
 DISCOVERY_TOPIC = "ros_discovery_info"  # a DDS name, outside ROS's conventions (no rt/ prefix)
 FAST_DDS_VENDOR = b"\x01\x0f"
@@ -83,3 +91,17 @@ def discovered_local_peers(writers: list[Any], pid: int) -> int | None:
         return None
     host = next(iter(own))[2:4]
     return sum(1 for p in prefixes - own if process_bits(p) is not None and p[2:4] == host)
+
+
+def unheard_participants(writers: list[Any], endpoints: list[Any], node_names: list[str], pid: int) -> int:
+    """How many participants of other processes whose ``ros_discovery_info`` writer is among ``writers``
+    have not told their nodes yet: none of ``endpoints`` (rclpy endpoint infos of every topic) with their
+    GUID prefix has a node name, and no node of roc's own in ``node_names`` is named for their process."""
+    told = {bytes(info.endpoint_gid)[:12] for info in endpoints if info.node_name != UNKNOWN_NODE}
+    roc_processes = {int(name[len(OWN_NODE_PREFIX):]) & 0xFFFF for name in node_names if is_own_node(name)}
+    unheard = 0
+    for prefix in {bytes(info.endpoint_gid)[:12] for info in writers}:
+        process = process_bits(prefix)
+        if process != pid & 0xFFFF and prefix not in told and process not in roc_processes:
+            unheard += 1
+    return unheard

@@ -27,7 +27,13 @@ from rclpy.signals import SignalHandlerOptions
 
 from roc import distribution
 from roc.errors import RocError
-from roc.ros.discovery import DISCOVERY_TOPIC, discovered_local_peers, local_participant_count
+from roc.ros.discovery import (
+    DISCOVERY_TOPIC,
+    UNKNOWN_NODE,
+    discovered_local_peers,
+    local_participant_count,
+    unheard_participants,
+)
 from roc.ros.params import WRITES, parameter_value
 from roc.ros.protocol import (
     DEFAULT_SPIN_TIME,
@@ -225,13 +231,21 @@ class Graph:
         return discovered is not None and discovered >= expected
 
     def _complete(self) -> bool:
-        """Every endpoint's node is known (a participant seen before its node names is not complete)."""
+        """Every endpoint's node is known (a participant seen before its node names is not complete), and
+        every participant discovered has told its nodes (roc.ros.discovery.unheard_participants)."""
         node = self.node
-        for name, _ in node.get_topic_names_and_types():
-            for info in (*node.get_publishers_info_by_topic(name), *node.get_subscriptions_info_by_topic(name)):
-                if info.node_name == "_NODE_NAME_UNKNOWN_":
-                    return False
-        return True
+        writers, endpoints = [], []
+        for name, _ in node.get_topic_names_and_types(no_demangle=True):  # services' request and reply too
+            found = [*node.get_publishers_info_by_topic(name, no_mangle=True),
+                     *node.get_subscriptions_info_by_topic(name, no_mangle=True)]
+            if name == DISCOVERY_TOPIC:
+                writers = found  # rmw's own endpoints: never a node name
+            elif any(info.node_name == UNKNOWN_NODE for info in found):
+                return False
+            else:
+                endpoints += found
+        names = [name for name, _ in node.get_node_names_and_namespaces()]
+        return unheard_participants(writers, endpoints, names, os.getpid()) == 0
 
     # -- roc's own participants (roc.ros.protocol.is_own_node) are in no answer ---------------------------
     def _nodes(self, own: bool = False) -> list[tuple[str, str]]:

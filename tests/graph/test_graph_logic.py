@@ -306,3 +306,25 @@ def test_discovered_peers_are_the_other_fast_dds_participants_of_this_host() -> 
                Writer("01107f01" "1111" "0000" "00000000")]  # another vendor
     assert discovered_local_peers(writers, pid) == 2  # one process, two participants
     assert discovered_local_peers(writers[1:], pid) is None  # this process's own writer not seen yet
+
+
+class Endpoint(Writer):
+    def __init__(self, prefix_hex: str, node_name: str):
+        super().__init__(prefix_hex)
+        self.node_name = node_name
+
+
+def test_a_participant_is_heard_once_an_endpoint_has_its_node_or_a_roc_node_names_its_process() -> None:
+    from roc.ros.discovery import UNKNOWN_NODE, unheard_participants
+
+    pid = 0x7322
+    ours, talker, listener, roc_daemon = ("010f7f01" "2273" "2073" "00000000", "010f7f01" "8272" "ae01" "00000000",
+                                          "010f7f01" "8272" "b001" "00000000", "010f7f01" "3412" "9999" "00000000")
+    writers = [Writer(prefix) for prefix in (ours, talker, listener, roc_daemon)]
+    # the talker's node is told; the listener's endpoints are seen before its node; roc's daemon has none
+    endpoints = [Endpoint(talker, "talker"), Endpoint(listener, UNKNOWN_NODE)]
+    assert unheard_participants(writers, endpoints, ["talker"], pid) == 2
+    assert unheard_participants(writers, endpoints, ["talker", f"_roc_{0x11234}"], pid) == 1  # pid's low 16 bits
+    endpoints.append(Endpoint(listener, "listener"))
+    assert unheard_participants(writers, endpoints, ["talker", "listener", f"_roc_{0x1234}"], pid) == 0
+    assert unheard_participants(writers, [], [], pid) == 3  # nothing told yet: only this process's own is not waited for
