@@ -17,7 +17,7 @@ from helpers.build import BIN, stop_process
 from helpers.graph import graph_env, read_line, roc, start_nodes, stop_all
 from websockets.sync.client import connect
 
-from roc.ros.foxglove_server import SEPARATOR, _Session, schema_text
+from roc.ros.bridges.foxglove_server import SEPARATOR, _Session, schema_text
 from roc.ros.interfaces import definition_path
 
 pytestmark = pytest.mark.xdist_group("busy_or_timing")  # see scripts/test.sh

@@ -229,7 +229,7 @@ def test_a_busy_listen_port_is_one_line(tmp_path: Path) -> None:
 
 
 def test_an_announcement_key_gives_back_the_topic_and_its_header() -> None:
-    from roc.ros.zenoh_link import _announced, _announcement
+    from roc.ros.bridges.zenoh_link import _announced, _announcement
 
     header = {"type": "sensor_msgs/msg/Image", "reliability": "best_effort", "durability": "volatile", "depth": 5}
     key = _announcement("a514b943", "/robot_1/camera/image", header)

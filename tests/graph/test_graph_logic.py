@@ -196,7 +196,7 @@ def test_beyond_this_host_discovery_waits_longer_for_quiet(monkeypatch):
 def test_a_domain_bridge_config_keeps_repeated_topics_and_reverses(tmp_path: Path) -> None:
     """domain_bridge's own example names a topic several times; each entry is a route."""
     from roc.commands.bridge.domains import routes_from_config
-    from roc.ros.bridge import Route
+    from roc.ros.bridges.domains import Route
 
     config = tmp_path / "bridge.yaml"
     config.write_text("name: my_bridge\nfrom_domain: 2\nto_domain: 3\ntopics:\n"
@@ -218,7 +218,7 @@ def test_a_domain_bridge_config_keeps_repeated_topics_and_reverses(tmp_path: Pat
 
 
 def test_an_action_is_bridged_as_its_services_and_topics() -> None:
-    from roc.ros.bridge import Route, action_routes
+    from roc.ros.bridges.domains import Route, action_routes
 
     parts = action_routes(Route("/fib", 1, 2, "test_msgs/action/Fibonacci", "/fob", kind="action"))
     assert [(p.kind, p.name, p.target, p.type) for p in parts] == [
@@ -231,7 +231,7 @@ def test_an_action_is_bridged_as_its_services_and_topics() -> None:
 
 def test_the_loop_guard_checks_the_user_s_profile(tmp_path: Path) -> None:
     from roc.errors import UsageError
-    from roc.ros.bridge import Route, loop_guard, two_way
+    from roc.ros.bridges.domains import Route, loop_guard, two_way
     from roc.ros.graph import BRIDGE_PROFILE
 
     both = [Route("/x", 1, 2), Route("/x", 2, 1)]

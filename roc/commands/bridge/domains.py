@@ -64,7 +64,7 @@ def routes_from_config(path: Path) -> list:
     """The routes of a domain_bridge YAML file: ``from_domain``, ``to_domain`` and ``topics``,
     ``services``, ``actions``: ``{NAME: {type, from_domain, to_domain, remap, qos, reversed,
     bidirectional}}``."""
-    from roc.ros.bridge import Route
+    from roc.ros.bridges.domains import Route
 
     settings, entries = _entries(path)
     if settings.get("mode", "normal") != "normal":
@@ -100,7 +100,7 @@ def routes_from_config(path: Path) -> list:
 
 
 def _routes(args: argparse.Namespace) -> list:
-    from roc.ros.bridge import Route
+    from roc.ros.bridges.domains import Route
 
     routes = routes_from_config(args.config) if args.config else []
     named = [*args.topics, *args.service, *args.action]
@@ -138,7 +138,7 @@ def status_text(event: dict[str, Any]) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Bridge the routes of the command line and ``--config`` until Ctrl+C."""
-    from roc.ros.bridge import DomainBridge
+    from roc.ros.bridges.domains import DomainBridge
 
     routes = _routes(args)
     exclude = args.exclude or ["^/rosout$", "^/parameter_events$"]

@@ -1,6 +1,6 @@
 """roc bridge --foxglove: a ROS domain served to Foxglove (the browser or desktop app) over the Foxglove
 WebSocket protocol; prints what it serves and live rates until Ctrl+C. The server is
-roc.ros.foxglove_server; this module holds only the options and the console."""
+roc.ros.bridges.foxglove_server; this module holds only the options and the console."""
 
 from __future__ import annotations
 
@@ -65,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"--port: expected 0 to 65535, got {args.port}")
     if args.domain is not None and not 0 <= args.domain <= 232:
         raise UsageError(f"--domain: expected a ROS domain id (0 to 232), got {args.domain}")
-    from roc.ros.foxglove_server import FoxgloveServer
+    from roc.ros.bridges.foxglove_server import FoxgloveServer
 
     server = FoxgloveServer(args.host, args.port, args.domain, args.include, args.exclude)
     try:

@@ -1,6 +1,6 @@
 """roc bridge --zenoh-listen/--zenoh-connect: the selected topics, services and actions carried between
 the local ROS domain and the far side's ``roc bridge`` over Zenoh, both ways; prints what it carries and
-live rates until Ctrl+C. The link is roc.ros.zenoh_link; this module holds only the options and the
+live rates until Ctrl+C. The link is roc.ros.bridges.zenoh_link; this module holds only the options and the
 console."""
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ def _text(event: dict[str, Any]) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Carry the selected topics, services and actions between the local domain and the Zenoh peers."""
-    from roc.ros.zenoh_link import ZenohLink, zenoh_config
+    from roc.ros.bridges.zenoh_link import ZenohLink, zenoh_config
 
     if args.from_domain is not None or args.to_domain is not None or args.config:
         raise UsageError("--from-domain, --to-domain and --config bridge domains; "

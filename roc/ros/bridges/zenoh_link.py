@@ -13,7 +13,7 @@ transient local topic's last ``depth`` messages stay in a Zenoh publication cach
 that joins later queries (a Zenoh advanced subscriber with history), so latched messages reach it too.
 Topics are looked for again every second, so a publisher that appears later is picked up. Services
 (and actions' services) named on both sides are offered by the side with the server
-(roc.ros.zenoh_services), announced the same way (``roc/announce/ZID/NAME/-/TYPE``).
+(roc.ros.bridges.zenoh_services), announced the same way (``roc/announce/ZID/NAME/-/TYPE``).
 
 No loops: the link forwards only topics with a publisher other than a bridge's (so a topic the link
 only republishes goes no further); the link's participant ignores its own endpoints (Fast DDS's
@@ -42,7 +42,7 @@ import zenoh.ext
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from roc.errors import RocError, UsageError
-from roc.ros.bridge import (
+from roc.ros.bridges.domains import (
     BRIDGE_NODE,
     Route,
     TopicFilter,
@@ -51,10 +51,10 @@ from roc.ros.bridge import (
     qos_name,
     receive_profile,
 )
+from roc.ros.bridges.zenoh_services import ServiceOffer, ServiceProxy
 from roc.ros.dataplane import qos_profile
 from roc.ros.graph import BRIDGE_PROFILE, Graph
 from roc.ros.types import message_class
-from roc.ros.zenoh_services import ServiceOffer, ServiceProxy
 
 SCAN_SECONDS = 1.0
 LINK_NODE = f"{BRIDGE_NODE}_zenoh"  # a bridge's node: domain bridges leave its topics alone too

@@ -1,4 +1,4 @@
-"""Services across a Zenoh link (roc.ros.zenoh_link): the side with the server offers it as a Zenoh
+"""Services across a Zenoh link (roc.ros.bridges.zenoh_link): the side with the server offers it as a Zenoh
 queryable on ``roc/service/NAME``; the far side serves the same name and type in its own domain and
 sends each request (serialised CDR) as a Zenoh query, answering with the reply.
 
@@ -16,7 +16,7 @@ from typing import Any
 import zenoh
 from rclpy.serialization import deserialize_message, serialize_message
 
-from roc.ros.bridge_services import WORKER_THREADS, ForwardingServer, call
+from roc.ros.bridges.services import WORKER_THREADS, ForwardingServer, call
 from roc.ros.graph import Graph
 from roc.ros.types import service_class
 

@@ -48,7 +48,7 @@ from websockets.exceptions import ConnectionClosed
 from websockets.typing import Subprotocol
 
 from roc.errors import RocError
-from roc.ros.bridge import TopicFilter, receive_profile
+from roc.ros.bridges.domains import TopicFilter, receive_profile
 from roc.ros.cdr import serialize
 from roc.ros.dataplane import qos_profile
 from roc.ros.graph import Graph

@@ -28,7 +28,7 @@ from typing import Any
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from roc.errors import UsageError
-from roc.ros.bridge_services import ServiceLink
+from roc.ros.bridges.services import ServiceLink
 from roc.ros.dataplane import RECEIVE_DEPTH, qos_profile
 from roc.ros.graph import BRIDGE_PROFILE, Graph, middleware, users_profile
 from roc.ros.types import message_class
