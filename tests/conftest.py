@@ -15,11 +15,14 @@ import signal
 from collections import Counter
 
 import pytest
+from helpers.build import share_compiles
 
 from roc import distribution
 
 FULL_SUITE_DISTRO = "jazzy"
 DISTRO = distribution.current({}).name  # the venv's (tests/helpers/build.py: DISTRO)
+
+share_compiles()
 
 if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)

@@ -6,6 +6,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 from roc import distribution
@@ -30,6 +31,28 @@ def ros_env(**extra: str) -> dict[str, str]:
     env["PATH"] = f"{BIN}{os.pathsep}{env.get('PATH', '/usr/bin:/bin')}"
     env.update(extra)
     return env
+
+
+SUITE_COMPILER_CACHE = ("CMAKE_C_COMPILER_LAUNCHER", "CMAKE_CXX_COMPILER_LAUNCHER", "CCACHE_DIR", "CCACHE_BASEDIR",
+                        "CCACHE_NOHASHDIR", "CCACHE_SLOPPINESS", "CCACHE_MAXSIZE")
+
+
+def share_compiles() -> None:
+    """Have CMake compile through ccache (when installed) for the rest of the test run, in one cache
+    under the temporary directory (concurrent use is safe), with paths under it made relative so that a
+    workspace copied elsewhere compiles from the cache. Left alone when the caller chose a launcher."""
+    if shutil.which("ccache") is None or "CMAKE_CXX_COMPILER_LAUNCHER" in os.environ:
+        return
+    temporary = tempfile.gettempdir()
+    os.environ.update(CMAKE_C_COMPILER_LAUNCHER="ccache", CMAKE_CXX_COMPILER_LAUNCHER="ccache",
+                      CCACHE_DIR=os.path.join(temporary, "roc-tests-ccache"), CCACHE_BASEDIR=temporary,
+                      CCACHE_NOHASHDIR="true", CCACHE_MAXSIZE="2G",
+                      CCACHE_SLOPPINESS="include_file_mtime,include_file_ctime,time_macros")
+
+
+def without_suite_compiler_cache(env: dict[str, str]) -> dict[str, str]:
+    """``env`` without share_compiles's variables (for tests of roc's own --compiler-cache)."""
+    return {name: value for name, value in env.items() if name not in SUITE_COMPILER_CACHE}
 
 
 def copy_fixture(name: str, destination: Path) -> Path:

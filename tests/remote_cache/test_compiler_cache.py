@@ -12,7 +12,7 @@ from __future__ import annotations
 import shutil
 
 import pytest
-from helpers.build import FIXTURES, in_sourced_shell, roc, ros_env
+from helpers.build import FIXTURES, in_sourced_shell, roc, ros_env, without_suite_compiler_cache
 from helpers.remote_servers import webdav
 
 pytestmark = pytest.mark.slow
@@ -37,7 +37,7 @@ def _compiles(result, tool: str) -> tuple[int, int]:
     shutil.which("ccache") is None,
     reason="ccache is not installed (ROC_SETUP_TEST_TOOLS=1 bash scripts/setup.sh installs it)"))])
 def test_second_checkout_compiles_from_the_local_compiler_cache(tmp_path, tool):
-    env = ros_env()
+    env = without_suite_compiler_cache(ros_env())
     options = ("--compiler-cache", tool, "--compiler-cache-dir", str(tmp_path / tool))
     first = _checkout(tmp_path, "first")
     built = roc("work", "build", *options, cwd=first, env=env)
@@ -60,7 +60,7 @@ def test_second_checkout_compiles_from_the_local_compiler_cache(tmp_path, tool):
 
 
 def test_compiler_cache_shares_the_remote_cache_server(tmp_path):
-    env = ros_env()
+    env = without_suite_compiler_cache(ros_env())
     root = tmp_path / "dav"
     (root / "team" / "sccache").mkdir(parents=True)  # wsgidav makes no parent folders on PUT: made once
     with webdav(root) as port:
