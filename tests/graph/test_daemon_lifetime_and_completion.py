@@ -12,8 +12,8 @@ import time
 from pathlib import Path
 
 import pytest
-from helpers.build import BIN, NODES, stop_process
-from helpers.graph import REPO, graph_env, read_line, roc, start_nodes, stop_all, stop_daemon
+from helpers.build import NODES, stop_process
+from helpers.graph import graph_env, read_line, roc, start_nodes, stop_all, stop_daemon, with_tf2_msgs
 
 from roc.ros import daemon
 
@@ -200,16 +200,8 @@ def test_fish_completes_graph_names(graph, tmp_path: Path, line: str, expected: 
 
 def test_frames_complete_from_tf(tmp_path: Path):
     """tf2_msgs (not among the wheels) built from the example workspace and sourced, a tf publisher."""
-    workspace = tmp_path / "tf"
-    shutil.copytree(REPO / "workspaces" / "example" / "src" / "tf2_msgs", workspace / "src" / "tf2_msgs")
-    built = subprocess.run([str(BIN / "roc"), "work", "build"], cwd=workspace, capture_output=True, text=True,
-                           timeout=600)
-    assert built.returncode == 0, built.stdout + built.stderr
     (tmp_path / "runtime").mkdir()
-    env = graph_env(27, tmp_path / "runtime")
-    dumped = subprocess.run(["bash", "-c", f'source "{workspace}/install/setup.bash" && env -0'], env=env,
-                            capture_output=True, timeout=60)
-    env = dict(item.split("=", 1) for item in dumped.stdout.decode().split("\0") if "=" in item)
+    env = with_tf2_msgs(graph_env(27, tmp_path / "runtime"))
     publisher = subprocess.Popen([sys.executable, str(NODES / "tf_node.py"), "publish"], env=env,
                                  stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     try:
