@@ -1,8 +1,9 @@
 """A running ``roc launch``'s status and control, for ``roc tui``: a private Unix socket per run in
 roc's runtime directory (``launch-<pid>.sock``, mode 0600), JSON lines in and out, one request a line:
 
-- ``{"method": "status"}`` -> ``{"title", "pid", "log_directory", "processes": [{name, pid, state,
-  detail, restarts, last_line, code}]}``;
+- ``{"method": "status"}`` -> ``{"title", "pid", "log_directory", "processes": [{name, host, pid, state,
+  detail, restarts, last_line, code}]}`` (host: the SSH destination of a process on another host, its pid
+  that of its ssh client here);
 - ``{"method": "stop", "process": NAME}``, ``{"method": "restart", "process": NAME}`` -> ``{"ok": true}`` or
   ``{"error": MESSAGE}``.
 
@@ -130,7 +131,8 @@ class StatusServer:
             monitor = self.running.monitor
             return {"title": self.running.options.title, "pid": os.getpid(),
                     "log_directory": str(self.running.log_directory) if self.running.log_directory else None,
-                    "processes": [{"name": r.name, "pid": r.pid, "state": r.state, "detail": r.detail,
+                    "processes": [{"name": r.name, "host": r.host or None, "pid": r.pid, "state": r.state,
+                                   "detail": r.detail,
                                    "restarts": r.restarts, "last_line": r.last_line, "code": r.code}
                                   for r in monitor.snapshot()]}
         if method in ("stop", "restart"):

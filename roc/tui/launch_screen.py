@@ -56,7 +56,8 @@ class LaunchScreen(Screen):
                 key = f"{answer['pid']}:{process['name']}"
                 owners[key] = status
                 state = process["state"] + (f" ({process['detail']})" if process["detail"] else "")
-                rows.append(Row(key, (process["name"], f"{answer['title']} [{answer['pid']}]",
+                shown = f"{process['host']}:{process['name']}" if process.get("host") else process["name"]
+                rows.append(Row(key, (shown, f"{answer['title']} [{answer['pid']}]",
                                       str(process["pid"] or "-"), state, str(process["restarts"]),
                                       process["last_line"]), PROBLEM_STATES.get(process["state"], [])))
         self.runs = owners

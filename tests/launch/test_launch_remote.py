@@ -23,6 +23,7 @@ from helpers.ssh import REMOTE, alive, ancestors, comm, ssh_server, sshd_session
 
 from roc.launch.guard import GRACE_SECONDS
 from roc.launch.remote_guard import SILENCE_SECONDS
+from roc.launch.status import runs
 
 pytestmark = pytest.mark.slow
 LOAD_MARGIN = 15.0  # a loaded CI machine: seconds beyond the documented bound before the test fails
@@ -63,8 +64,9 @@ def _stopped_within(pid: int, bound: float, what: str) -> float:
     return elapsed
 
 
-def test_a_remote_process_runs_beside_a_local_one_as_explained(remote, tmp_path: Path) -> None:
+def test_a_remote_process_runs_beside_a_local_one_as_explained(remote, tmp_path: Path, monkeypatch) -> None:
     env, prefix, _ = remote
+    monkeypatch.setenv("XDG_RUNTIME_DIR", env["XDG_RUNTIME_DIR"])
     write_pair(tmp_path, prefix)
     explained = roc("-C", str(tmp_path), "launch", "pair", "--explain", "--format", "json", env=env)
     assert explained.returncode == 0, explained.stderr
@@ -86,6 +88,9 @@ def test_a_remote_process_runs_beside_a_local_one_as_explained(remote, tmp_path:
         assert listener["host"] == "robot" and listener["env"]["ROC_TEST_MARK"] == "far"
         assert listener["env"]["ROS_DOMAIN_ID"] == env["ROS_DOMAIN_ID"]  # the system's ROS settings
         assert re.fullmatch(r".+@robot/local/far_listener/1", proc_environ(remote_pid)["ROC_LAUNCH_ID"])
+        status, = [status for _, status in runs() if status["pid"] == launcher.pid]  # roc tui's launches view
+        rows = {process["name"]: (process["host"], process["state"]) for process in status["processes"]}
+        assert rows == {"local/talker": (None, "running"), "local/far_listener": ("robot", "running")}
         local_env = {k: v for k, v in proc_environ(local_pid).items() if k != "ROC_LAUNCH_ID"}
         assert local_env == {k: v for k, v in proc_environ(launcher.pid).items()}  # roc's own, nothing added
     finally:
