@@ -82,9 +82,12 @@ def read_line(process: subprocess.Popen, timeout: float = 20.0) -> str | None:
     read its stdout only through this."""
     lines = _lines(process)
     try:
-        return lines.get(timeout=max(0.01, timeout))
+        line = lines.get(timeout=max(0.01, timeout))
     except queue.Empty:
         return None
+    if line == "":
+        lines.put("")  # the end stays the end: the next call returns at once too
+    return line
 
 
 def wait_for(condition, timeout: float = 20.0) -> None:
