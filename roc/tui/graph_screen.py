@@ -39,6 +39,15 @@ SYSTEM = ("nodes", "topics")
 NARROW = 100  # below this many columns, the nodes are above the topics instead of beside them
 
 
+class ListTabs(TabbedContent):
+    """Tabs that change only when asked (a key, a click on a tab), never because a list inside one got the
+    focus: Textual follows the focus a moment later, so a tab chosen just then was switched back."""
+
+    def _on_tab_pane_focused(self, event: TabPane.Focused) -> None:
+        event.prevent_default()
+        event.stop()
+
+
 class GraphScreen(Screen):
     BINDINGS = [
         Binding("slash", "filter", "filter"),
@@ -93,7 +102,7 @@ class GraphScreen(Screen):
     def compose(self) -> ComposeResult:
         yield Static(self.status, id="header")
         yield Static("", id="problems")
-        with TabbedContent(initial="system-tab", id="tabs"):
+        with ListTabs(initial="system-tab", id="tabs"):
             with TabPane("System", id="system-tab"), Container(id="system"):
                 for name in SYSTEM:
                     yield self.list_table(name)

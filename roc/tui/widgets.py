@@ -78,6 +78,14 @@ class ListTable(DataTable):
         for name in self.columns_names:
             self.add_column(name, key=name, width=self.widths.get(name))
 
+    def _on_hide(self, event) -> None:
+        """A focused table that its tab hides lets the focus go, instead of Textual's move to a visible
+        sibling: in a hidden tab the sibling is hidden too, and focusing it brings its tab back (the
+        first screen's Tab or ``3`` then bounced back to the nodes). The screen focuses the new tab's list."""
+        if self.screen.focused is self:  # not has_focus: it follows a moment later, by a Blur event
+            self.screen.set_focus(None)
+        super()._on_hide(event)
+
     def _update_dimensions(self, new_rows) -> None:
         """DataTable's, then the rows drawn before they were measured are drawn again where their columns
         widened: Textual 8.2 does that only on a Resize event, which does not always follow (a screen kept

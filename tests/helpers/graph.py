@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 from helpers.build import BIN, ros_domain_id, stop_process
+from helpers.build import roc as roc_build
 from helpers.oracles import SHARED, require_oracle
 
 NODE_SCRIPT = Path(__file__).resolve().parents[1] / "nodes" / "graph_node.py"
@@ -200,3 +201,32 @@ def assert_call_and_goal_work(env: dict[str, str]) -> None:
     assert goal.returncode == 0, goal.stderr
     assert "sequence:\n- 0\n- 1\n- 1\n- 2\n- 3\n- 5\n" in goal.stdout
     assert "Goal finished with status: SUCCEEDED" in goal.stdout
+
+
+def with_tf2_msgs(env: dict[str, str]) -> dict[str, str]:
+    """``env`` with tf2_msgs sourced: the example workspace's, built by roc once per source and venv
+    into the test cache (ROC_TEST_CACHE) and shared by every test file and worker that needs it (a lock
+    file: one builds, the others wait), so a run builds it once, not once per file."""
+    import fcntl
+    import hashlib
+    import shutil
+
+    source = REPO / "workspaces" / "example" / "src" / "tf2_msgs"
+    digest = hashlib.sha256(sys.prefix.encode())
+    for path in sorted(source.rglob("*")):
+        if path.is_file():
+            digest.update(str(path.relative_to(source)).encode() + path.read_bytes())
+    cache = ORACLE_VENV.parent / f"tf2_msgs-{digest.hexdigest()[:16]}"
+    cache.parent.mkdir(parents=True, exist_ok=True)
+    with open(cache.parent / f"{cache.name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not (cache / "built").exists():
+            shutil.rmtree(cache, ignore_errors=True)
+            shutil.copytree(source, cache / "src" / "tf2_msgs")
+            built = roc_build("work", "build", cwd=cache, timeout=900)
+            assert built.returncode == 0, built.stdout + built.stderr
+            (cache / "built").touch()
+    dumped = subprocess.run(["bash", "-c", f'source "{cache}/install/setup.bash" && env -0'], env=env,
+                            capture_output=True, timeout=60)
+    assert dumped.returncode == 0, dumped.stderr
+    return dict(item.split("=", 1) for item in dumped.stdout.decode().split("\0") if "=" in item)

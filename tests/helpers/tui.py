@@ -56,7 +56,10 @@ async def open_row(app, pilot, tab: str, name: str) -> None:
     await until(pilot, lambda: name in table(app, f"#{tab}-table").rows_by_key, what=name)
     await pilot.press("slash", *name, "enter")
     rows = table(app, f"#{tab}-table")
-    await until(pilot, lambda: rows.selected_key() == name, what=f"{name} alone")
+    try:
+        await until(pilot, lambda: rows.selected_key() == name, what=f"{name} alone")
+    except AssertionError as error:
+        raise AssertionError(f"{error} (focused: {app.focused}); the screen:\n" + "\n".join(screen_lines(app))) from None
     await pilot.press("enter")
 
 

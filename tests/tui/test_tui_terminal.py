@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 from helpers.build import BIN, NODES, REPO, ros_env, stop_process
-from helpers.graph import graph_env, read_line, start_nodes, stop_all, stop_daemon
+from helpers.graph import graph_env, read_line, start_nodes, stop_all, stop_daemon, with_tf2_msgs
 from helpers.tui import make_workspace
 
 pytestmark = pytest.mark.slow
@@ -132,17 +132,10 @@ def test_work_build_tui_in_a_terminal(tmp_path: Path) -> None:
 
 def test_the_tf_tree_in_a_terminal(tmp_path: Path) -> None:
     """The tf screen (f): each frame under its parent with its rate and publishing node, live; tf2_msgs
-    built by roc from the example workspace and sourced, the tree published by tests/nodes/tf_node.py."""
-    workspace = tmp_path / "tf"
-    shutil.copytree(REPO / "workspaces" / "example" / "src" / "tf2_msgs", workspace / "src" / "tf2_msgs")
-    built = subprocess.run([str(BIN / "roc"), "work", "build"], cwd=workspace, env=ros_env(), capture_output=True,
-                           text=True, timeout=600)
-    assert built.returncode == 0, built.stdout + built.stderr
+    built by roc from the example workspace (once per test run: helpers.graph.with_tf2_msgs) and sourced,
+    the tree published by tests/nodes/tf_node.py."""
     (tmp_path / "runtime").mkdir()
-    env = graph_env(38, tmp_path / "runtime", TERM="xterm-256color")
-    dumped = subprocess.run(["bash", "-c", f'source "{workspace}/install/setup.bash" && env -0'], env=env,
-                            capture_output=True, timeout=60, check=True)
-    env = dict(item.split("=", 1) for item in dumped.stdout.decode().split("\0") if "=" in item)
+    env = with_tf2_msgs(graph_env(38, tmp_path / "runtime", TERM="xterm-256color"))
     publisher = subprocess.Popen([sys.executable, str(TF_NODE), "publish"], env=env, stdout=subprocess.PIPE,
                                  stderr=subprocess.DEVNULL, text=True)
     terminal = Terminal(tmp_path, [str(BIN / "roc"), "tui", "--no-workspace"], env, tmp_path)
@@ -156,7 +149,7 @@ def test_the_tf_tree_in_a_terminal(tmp_path: Path) -> None:
         assert "map" in lines and "└── odom [static, /tf_publish]" in lines, screen
         assert "└── laser [static, /tf_publish]" in lines, screen
         terminal.keys("Escape")  # then wait: Esc and q at once read as Alt+Q
-        terminal.wait(lambda s: "Topics" in s and "tf frames (from" not in s, "the graph again")
+        terminal.wait(lambda s: "System" in s and "tf frames (from" not in s, "the first screen again")
         terminal.keys("q")
         assert terminal.exit_code() == 0
     finally:
