@@ -10,10 +10,13 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable, Iterator
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from roc.errors import RocError
 from roc.ros.client import DaemonError, Session, start_daemon
+
+if TYPE_CHECKING:
+    from concurrent.futures import Future
 
 CALL_TIMEOUT = 5.0  # seconds for a node's service to answer, as roc's verbs wait
 
@@ -25,6 +28,23 @@ class Feed:
     def __init__(self) -> None:
         self._session: Session | None = None
         self._lock = threading.Lock()
+        self._first: Future | None = None
+
+    def prefetch(self) -> None:
+        """Ask for the first snapshot now, on a thread of its own: the daemon answers while the app's
+        modules load (about as long as its answer takes), so that the first screen can show the graph."""
+        from concurrent.futures import Future
+
+        first: Future = Future()
+
+        def ask() -> None:
+            try:
+                first.set_result(self.query("snapshot", {"endpoints": True}))
+            except BaseException as error:  # noqa: BLE001 - raised again where the snapshot is taken
+                first.set_exception(error)
+
+        self._first = first
+        threading.Thread(target=ask, name="roc-tui-prefetch", daemon=True).start()
 
     def session(self) -> Session:
         with self._lock:
@@ -36,7 +56,11 @@ class Feed:
         return self.session().query(method, params)
 
     def snapshot(self) -> dict[str, Any]:
-        """Nodes, topics with their endpoints (for the diagnoses), services, actions."""
+        """Nodes, topics with their endpoints (for the diagnoses), services, actions (the first time, the
+        prefetched answer, if any)."""
+        first, self._first = self._first, None
+        if first is not None:
+            return first.result()
         return self.query("snapshot", {"endpoints": True})
 
     def stream(self, method: str, params: dict[str, Any], stop: Callable[[], bool]) -> Iterator[dict[str, Any]]:
@@ -55,7 +79,6 @@ class Feed:
                     yield response
         finally:
             connection.close()
-
 
     def call(self, service: str, type_name: str, request: dict[str, Any], timeout: float = CALL_TIMEOUT) -> Any:
         """Call a service with a request given as plain data; its response as plain data (the daemon

@@ -106,25 +106,30 @@ class ListTable(DataTable):
     def show(self, rows: Iterable[Row]) -> None:
         self._all = list(rows)
         shown = [r for r in self._all if not self.filter or matches(self.filter, *r.cells)]
+        if not self._shown and len(shown) > self.app.size.height:
+            # the first fill: the rows a screen can show now (a first paint of 200 topics costs their
+            # measuring), the others right after it is painted
+            shown = shown[:self.app.size.height]
+            self.call_after_refresh(lambda: self.show(self._all))
         keys = [r.key for r in shown]
-        if keys != self._shown:
-            current = self.selected_key()
+        current = self.selected_key()
+        if keys[:len(self._shown)] != self._shown:  # rows gone or moved: all drawn again
             self.clear()
-            for row in shown:
-                self.add_row(*self._cells(row), key=row.key)
-            if current in keys:
-                self.move_cursor(row=keys.index(current), animate=False)
-        else:
-            columns = (["!"] if self.marks else []) + list(self.columns_names)
-            for row in shown:
-                old = self.rows_by_key.get(row.key)
-                if old == row:
-                    continue
-                for column, value, before in zip(columns, self._cells(row), self._cells(old) if old else []):
-                    if value != before:
-                        width = self.columns[ColumnKey(column)].content_width
-                        grows = column not in self.widths and value.cell_len > width
-                        self.update_cell(row.key, column, value, update_width=grows)
+            self._shown, self.rows_by_key = [], {}
+        columns = (["!"] if self.marks else []) + list(self.columns_names)
+        for row in shown[:len(self._shown)]:  # the rows drawn before: only their changed cells
+            old = self.rows_by_key.get(row.key)
+            if old == row:
+                continue
+            for column, value, before in zip(columns, self._cells(row), self._cells(old) if old else []):
+                if value != before:
+                    width = self.columns[ColumnKey(column)].content_width
+                    grows = column not in self.widths and value.cell_len > width
+                    self.update_cell(row.key, column, value, update_width=grows)
+        for row in shown[len(self._shown):]:  # new rows, at the end
+            self.add_row(*self._cells(row), key=row.key)
+        if not self._shown and current in keys:
+            self.move_cursor(row=keys.index(current), animate=False)
         self._shown = keys
         self.rows_by_key = {r.key: r for r in shown}
 
@@ -145,6 +150,11 @@ class ListTable(DataTable):
     def selected(self) -> Row | None:
         key = self.selected_key()
         return self.rows_by_key.get(key) if key else None
+
+    def keys_in_view(self, margin: int = 2) -> set[str]:
+        """The keys of the rows on the screen (and ``margin`` more each side)."""
+        first = int(self.scroll_y)
+        return set(self._shown[max(0, first - margin):first + self.size.height + margin])
 
     @property
     def shown_count(self) -> int:

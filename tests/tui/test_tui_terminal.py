@@ -15,7 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
-from helpers.build import BIN, NODES, REPO, ros_env, stop_process
+from helpers.build import BIN, NODES, ros_env, stop_process
 from helpers.graph import graph_env, read_line, start_nodes, stop_all, stop_daemon, with_tf2_msgs
 from helpers.tui import make_workspace
 
