@@ -81,7 +81,8 @@ class Supervisor:
             process.stdout.close()
             code = process.wait()
             self.monitor.exited(spec.label, process.pid, code, command)
-            if not spec.respawn or self.stopping.is_set() or self.stopping.wait(spec.respawn_delay):
+            asked = spec.label in self.monitor.stop_asked  # stopped on request: no respawn, no failure
+            if not spec.respawn or asked or self.stopping.is_set() or self.stopping.wait(spec.respawn_delay):
                 break
             try:
                 process = self._spawn(spec, command)
@@ -90,7 +91,7 @@ class Supervisor:
                 break
         with self._lock:
             self._running.pop(spec.label, None)
-            if code != 0 and not self.stopping.is_set():
+            if code != 0 and not self.stopping.is_set() and spec.label not in self.monitor.stop_asked:
                 self.failed.append(spec.label)
             self._changed.notify_all()
 

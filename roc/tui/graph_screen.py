@@ -176,7 +176,7 @@ class GraphScreen(Screen):
         if published != self.measured:
             self.measured = published
             self.rates.keep(set(published))
-            self.measure(published)
+            self.call_after_refresh(self.measure, published)  # once this is on the screen
         self.show_detail()
 
     def on_screen_resume(self) -> None:

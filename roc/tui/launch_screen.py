@@ -1,6 +1,7 @@
 """The ``roc launch`` runs of this host (roc.launch.status): each process with its run, pid, state,
 restarts and last line of output, refreshed every second; Enter shows a process's output as the logs
-view shows /rosout; ``s`` stops a process, ``R`` restarts it (a process of a roc.toml system)."""
+view shows /rosout; ``s`` stops a process (on purpose: the run goes on, and does not fail for it), ``R``
+restarts one of a roc.toml system (the launch library starts a launch file's processes once)."""
 
 from __future__ import annotations
 
@@ -34,6 +35,7 @@ class LaunchScreen(Screen):
     def __init__(self) -> None:
         super().__init__()
         self.runs: dict[str, Any] = {}  # row key -> the roc.launch.status.RunStatus of its run
+        self.restartable: dict[str, bool] = {}  # row key -> whether its run can start it again
 
     def compose(self) -> ComposeResult:
         yield Static(Text("roc launch runs on this host: looking...", style="bold"), id="title")
@@ -50,18 +52,19 @@ class LaunchScreen(Screen):
         from roc.launch.status import runs
 
         found = runs()
-        rows, owners = [], {}
+        rows, owners, restartable = [], {}, {}
         for status, answer in found:
             for process in answer["processes"]:
                 key = f"{answer['pid']}:{process['name']}"
                 owners[key] = status
+                restartable[key] = answer.get("restartable", True)
                 state = process["state"] + (f" ({process['detail']})" if process["detail"] else "")
                 rows.append(Row(key, (process["name"], f"{answer['title']} [{answer['pid']}]",
                                       str(process["pid"] or "-"), state, str(process["restarts"]),
                                       process["last_line"]), PROBLEM_STATES.get(process["state"], [])))
-        self.runs = owners
-        title = (f"roc launch runs on this host: {len(found)}  (Enter: output, s: stop, R: restart)" if found
-                 else "no roc launch runs on this host (for this user)")
+        self.runs, self.restartable = owners, restartable
+        title = (f"roc launch runs on this host: {len(found)}  (Enter: output, s: stop, R: restart a roc.toml "
+                 "system's process)" if found else "no roc launch runs on this host (for this user)")
         self.app.call_from_thread(self.show, rows, title)
 
     def show(self, rows: list[Row], title: str) -> None:
@@ -86,6 +89,12 @@ class LaunchScreen(Screen):
         if chosen is None:
             return
         status, process = chosen
+        key = self.query_one("#processes", ListTable).selected_key() or ""
+        if method == "restart" and not self.restartable.get(key, True):
+            self.notify(f"{process} was started by a launch file: the launch library starts each of its processes "
+                        "once and cannot start one again on request (a system declared in roc.toml can)",
+                        title="cannot restart", timeout=8)
+            return
         try:
             status.request(method, process=process)
         except (RocError, OSError) as error:

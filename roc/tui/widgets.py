@@ -11,7 +11,7 @@ from textual.app import ComposeResult
 from textual.binding import Binding, BindingType
 from textual.containers import Vertical
 from textual.screen import ModalScreen
-from textual.widgets import DataTable, Input, Static, TextArea
+from textual.widgets import DataTable, Input, Static
 from textual.widgets.data_table import ColumnKey
 
 from roc.tui.feed import Feed
@@ -203,6 +203,8 @@ class TextViewer(ModalScreen[None]):
     def compose(self) -> ComposeResult:
         with Vertical():
             yield Static(Text(self.title_text, style="bold"))
+            from textual.widgets import TextArea  # not before a viewer opens: a first screen without it is faster
+
             yield TextArea(self.text, read_only=True, soft_wrap=False, id="viewer")
 
     def action_close(self) -> None:

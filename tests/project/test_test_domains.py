@@ -21,9 +21,9 @@ def _domains(monkeypatch, base: str, workers: int) -> list[int]:
 
 def test_the_base_moves_every_domain_and_none_is_shared(monkeypatch):
     default = _domains(monkeypatch, "20", 2)
-    moved = _domains(monkeypatch, "120", 2)
+    moved = _domains(monkeypatch, "90", 2)
     assert len(set(default)) == len(default) == 2 * DOMAIN_SLOTS
-    assert sorted(moved) == [d + 100 for d in sorted(default)]
+    assert sorted(moved) == [d + 70 for d in sorted(default)]
     assert min(default) == 20 and max(moved) <= DOMAIN_MAX
 
 

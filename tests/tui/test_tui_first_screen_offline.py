@@ -68,7 +68,9 @@ def test_the_first_screen_shows_the_snapshot_asked_for_before_the_app_loaded() -
 
         snapshot = Feed.snapshot
 
-    feed = CountingFeed(still_snapshot())
+    feed = CountingFeed({"nodes": [], "topics": [{"name": "/t", "types": ["std_msgs/msg/String"], "publishers": 0,
+                                                  "subscribers": 0, "endpoints": {"publishers": [], "subscribers": []}}],
+                         "services": [], "actions": []})
     feed.prefetch()
     assert feed.snapshot()["asked"] == 1 and feed.snapshot()["asked"] == 2
 
@@ -146,3 +148,31 @@ def test_the_lists_under_another_screen_are_drawn_when_it_is_back() -> None:
             await pilot.press("escape")
             await until(pilot, lambda: "/t004" in topics.rows_by_key, what="the new topics")
     asyncio.run(test())
+
+
+def test_endpoints_are_asked_for_again_only_when_counts_change_or_after_a_while() -> None:
+    """A topic's endpoints (QoS, gids) come with every snapshot, but the daemon is asked for them only
+    when a topic's counts change or ENDPOINTS_SECONDS passed."""
+    endpoint = {"node_name": "talker", "node_namespace": "/", "gid": "01.0f", "qos": {}}
+    graph = {"subscribers": 0}
+    asked = []
+
+    class CountingFeed(Feed):
+        def query(self, method, params=None):
+            asked.append(params["endpoints"])
+            topic = {"name": "/chatter", "types": ["std_msgs/msg/String"], "publishers": 1,
+                     "subscribers": graph["subscribers"]}
+            if params["endpoints"]:
+                topic["endpoints"] = {"publishers": [endpoint], "subscribers": [endpoint] * graph["subscribers"]}
+            return {"nodes": [], "topics": [topic], "services": [], "actions": []}
+
+    feed = CountingFeed()
+    assert feed.snapshot()["topics"][0]["endpoints"]["publishers"] == [endpoint]
+    assert feed.snapshot()["topics"][0]["endpoints"]["publishers"] == [endpoint]
+    assert asked == [True, False]
+    graph["subscribers"] = 1
+    assert len(feed.snapshot()["topics"][0]["endpoints"]["subscribers"]) == 1
+    assert asked == [True, False, False, True]
+    feed._endpoints_due = 0.0  # ENDPOINTS_SECONDS later
+    feed.snapshot()
+    assert asked == [True, False, False, True, True]
