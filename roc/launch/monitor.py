@@ -112,9 +112,11 @@ class Monitor:
         with self._lock:
             row = self._row(name)
             row.code = code
-            if code == 0:
+            if name in self.stop_asked:
+                row.state, row.detail = "stopped", f"exit code {code}"
+            elif code == 0:
                 row.state, row.detail = "exited", "exit code 0"
-            elif self.stopping.is_set() or name in self.stop_asked:
+            elif self.stopping.is_set():
                 row.state, row.detail = "stopped", f"exit code {code}"
             else:
                 row.state, row.detail = "failed", f"exit code {code}"

@@ -30,6 +30,7 @@ class LaunchScreen(Screen):
     DEFAULT_CSS = """
     LaunchScreen #title { height: 1; background: $primary; }
     LaunchScreen ListTable { height: 1fr; }
+    LaunchScreen #detail { height: 1; color: $text-muted; }
     """
 
     def __init__(self) -> None:
@@ -40,6 +41,7 @@ class LaunchScreen(Screen):
     def compose(self) -> ComposeResult:
         yield Static(Text("roc launch runs on this host: looking...", style="bold"), id="title")
         yield ListTable(("process", "run", "pid", "state", "restarts", "last line"), marks=True, id="processes")
+        yield Static("", id="detail")
         yield Footer()
 
     def on_mount(self) -> None:
@@ -70,6 +72,19 @@ class LaunchScreen(Screen):
     def show(self, rows: list[Row], title: str) -> None:
         self.query_one("#title", Static).update(Text(title, style="bold"))
         self.query_one("#processes", ListTable).show(rows)
+        self.show_detail()
+
+    def show_detail(self) -> None:
+        """Under the list, what can be done with the process under the cursor."""
+        key = self.query_one("#processes", ListTable).selected_key()
+        text = "" if key is None else (
+            "Enter: its output, s: stop it, R: restart it" if self.restartable.get(key, True) else
+            "Enter: its output, s: stop it; a launch file's process cannot be restarted (the launch library "
+            "starts each once)")
+        self.query_one("#detail", Static).update(Text(text))
+
+    def on_data_table_row_highlighted(self, _event: DataTable.RowHighlighted) -> None:
+        self.show_detail()
 
     def selected(self) -> tuple[Any, str] | None:
         key = self.query_one("#processes", ListTable).selected_key()
@@ -94,6 +109,8 @@ class LaunchScreen(Screen):
             self.notify(f"{process} was started by a launch file: the launch library starts each of its processes "
                         "once and cannot start one again on request (a system declared in roc.toml can)",
                         title="cannot restart", timeout=8)
+            self.query_one("#detail", Static).update(Text(f"{process}: cannot restart a launch file's process (the "
+                                                          "launch library starts each once); s stops it", style="bold"))
             return
         try:
             status.request(method, process=process)

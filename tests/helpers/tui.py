@@ -174,8 +174,10 @@ class Terminal:
         self.socket = directory / "tmux.sock"
         self.status = directory / "status"
         script = directory / "run.sh"
-        exports = "".join(f"export {name}={shlex.quote(value)}\n" for name, value in env.items()
-                          if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name))
+        # never COLUMNS and LINES: pytest-xdist's workers have them (80, 24), and Textual takes them for the size
+        exports = "unset COLUMNS LINES\n" + "".join(
+            f"export {name}={shlex.quote(value)}\n" for name, value in env.items()
+            if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name) and name not in ("COLUMNS", "LINES"))
         script.write_text(f"{exports}cd {shlex.quote(str(cwd))}\n{shlex.join(command)}\n"
                           f"echo $? > {shlex.quote(str(self.status))}\nsleep 60\n")
         config = directory / "tmux.conf"
