@@ -77,6 +77,55 @@ def key_line(text: str, start: int, key: str) -> int:
     return start
 
 
+def _value_tokens(text: str, line: int):
+    """(line, character) of each character of the value of the key on line ``line`` and of what follows it,
+    without spaces and comments, each string as one ``"``."""
+    quote = ""
+    for number, content in enumerate(text.splitlines()[line - 1:], line):
+        column = content.find("=") + 1 if number == line else 0
+        while column < len(content):
+            if quote:
+                if quote[0] == '"' and content[column] == "\\":
+                    column += 2
+                elif content.startswith(quote, column):
+                    column, quote = column + len(quote), ""
+                else:
+                    column += 1
+                continue
+            char = content[column]
+            if char == "#":
+                break
+            if char in "\"'":
+                quote = char * 3 if content.startswith(char * 3, column) else char
+                column += len(quote)
+                yield number, '"'
+                continue
+            if not char.isspace():
+                yield number, char
+            column += 1
+
+
+def array_item_lines(text: str, line: int) -> list[int]:
+    """The line of each item of the array that is the value of the key on line ``line`` (``nodes = [...]``,
+    ``topic = [{...}, {...}]``; TOML's inline tables never span lines)."""
+    found: list[int] = []
+    depth, expecting = 0, False
+    for number, char in _value_tokens(text, line):
+        if depth == 1 and expecting and char not in ",]":
+            found.append(number)
+            expecting = False
+        if char in "[{":
+            depth += 1
+            expecting = expecting or depth == 1
+        elif char in "]}":
+            depth -= 1
+            if depth <= 0:
+                break
+        elif char == "," and depth == 1:
+            expecting = True
+    return found
+
+
 def type_names(types: tuple[type, ...]) -> str:
     """``a string``, ``an integer or a number``: what a value of ``types`` is, for messages."""
     names = {bool: "true or false", int: "an integer", float: "a number", str: "a string", list: "a list",

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Fix up installed ROS 2 Jazzy PyPI wheels so that ament_cmake/rosidl builds work.
+"""Fix up installed ROS 2 PyPI wheels (Jazzy or Kilted) so that ament_cmake/rosidl builds work.
 
 The wheels were built in a manylinux container and hard-code paths of that
 container in some installed CMake files (see shared/ros2-wheels.md):
@@ -9,9 +9,11 @@ container in some installed CMake files (see shared/ros2-wheels.md):
    refuses imported targets with non-existent include paths.  They are
    rewritten to this interpreter's include directory and this environment's
    ``numpy.get_include()``.
-2. ``share/fastrtps/cmake/fastrtps-shared-targets.cmake`` links
-   ``/usr/lib64/libtinyxml2.so``, which does not exist here; the entry is
-   removed (libfastrtps already needs the bundled tinyxml2).
+2. Fast DDS's exported targets link ``/usr/lib64/libtinyxml2.so``, which
+   does not exist here; the entry is removed (the library already needs the
+   bundled tinyxml2). Jazzy's Fast DDS 2 has them in
+   ``share/fastrtps/cmake/fastrtps-shared-targets.cmake``, Kilted's Fast DDS 3
+   in ``share/fastdds/cmake/fastdds-shared-targets.cmake``.
 
 Run it with the Python of the environment holding the wheels (it works on
 ``sys.prefix``, or on the prefix given with --prefix).  It is idempotent and
@@ -37,6 +39,8 @@ _NUMPY_INCLUDE_RE = re.compile(
     r"/opt/python/cp\d+-cp\d+t?/lib/python3\.\d+t?/site-packages/numpy/_?core/include"
 )
 _TINYXML2 = "/usr/lib64/libtinyxml2.so"
+# Fast DDS's exported targets: Fast DDS 2 (Jazzy, libfastrtps), Fast DDS 3 (Kilted, libfastdds)
+FASTDDS_TARGETS = ("fastrtps/cmake/fastrtps-shared-targets.cmake", "fastdds/cmake/fastdds-shared-targets.cmake")
 
 
 def _write_atomic(path: Path, text: str) -> None:
@@ -67,7 +71,7 @@ def fix_rosidl_py_exports(text: str, py_include: str, numpy_include: str) -> str
     return _PY_INCLUDE_RE.sub(lambda _m: py_include, text)
 
 
-def fix_fastrtps_targets(text: str) -> str:
+def fix_fastdds_targets(text: str) -> str:
     """Drop the libtinyxml2 entry from the semicolon-separated link lists."""
 
     def fix_list(m: re.Match[str]) -> str:
@@ -115,14 +119,14 @@ def main(argv: list[str] | None = None) -> int:
         if new != old:
             changes.append((path, new))
 
-    fastrtps = share / "fastrtps" / "cmake" / "fastrtps-shared-targets.cmake"
-    if fastrtps.is_file():
-        old = _read(fastrtps)
-        new = fix_fastrtps_targets(old)
+    fastdds = [share / name for name in FASTDDS_TARGETS if (share / name).is_file()]
+    for path in fastdds:
+        old = _read(path)
+        new = fix_fastdds_targets(old)
         if new != old:
-            changes.append((fastrtps, new))
+            changes.append((path, new))
 
-    if not exports and not fastrtps.is_file():
+    if not exports and not fastdds:
         print(f"fix_ros_wheels: warning: no ROS wheel CMake files found under {share}", file=sys.stderr)
 
     if args.check:
@@ -138,7 +142,7 @@ def main(argv: list[str] | None = None) -> int:
     print(
         f"fix_ros_wheels: changed {len(changes)} file(s) under {prefix} "
         f"({len(exports)} rosidl_generator_py export file(s) checked, "
-        f"fastrtps targets {'checked' if fastrtps.is_file() else 'not found'})"
+        f"Fast DDS targets {'checked' if fastdds else 'not found'})"
     )
     return 0
 

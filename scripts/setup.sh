@@ -1,16 +1,22 @@
 #!/usr/bin/env bash
-# Set up roc's development/CI environment in <repo>/.venv:
+# Set up roc's development/CI environment for one ROS 2 distribution:
+#   bash scripts/setup.sh                   .venv         ROS 2 Jazzy (the default)
+#   bash scripts/setup.sh --distro kilted   .venv-kilted  ROS 2 Kilted
+# Each is
 #   - a venv made with python3 -m venv (or $PYTHON -m venv),
 #   - roc installed editable with its test extra (pytest, pytest-xdist, colcon as test oracle),
-#   - the ROS 2 Jazzy PyPI wheels of requirements/ros-jazzy.txt,
-#   - the fix-ups of those wheels' CMake files (scripts/fix_ros_wheels.py).
+#   - the ROS 2 PyPI wheels of requirements/ros-DISTRO.txt (the two distributions pin the same ros-*
+#     wheels at their own versions, so they never share a venv),
+#   - the fix-ups of those wheels' CMake files (scripts/fix_ros_wheels.py),
+#   - the launch system from ../shared/oracles/install_launch.sh, when it is there.
 # Idempotent: when nothing it depends on changed since the last successful run (stamp in
-# .venv/.roc-setup-stamp) it only re-checks the fix-ups and prints one line.
+# VENV/.roc-setup-stamp) it only re-checks the fix-ups and prints one line.
 # Only the dev/CI environment lives here: roc itself never assumes the venv's paths.
 # It changes nothing outside the checkout (and pip's cache) unless asked:
-#   ROC_SETUP_TEST_TOOLS=1  also install zsh, fish, tmux and ccache with the system's package manager
-#                       (apt-get, as root), so that the tests of roc's zsh/fish setup scripts and
-#                       completions, of roc tui in a real terminal and of --compiler-cache ccache run
+#   ROC_SETUP_TEST_TOOLS=1  also install zsh, fish, tmux, ccache and openssh-server with the system's
+#                       package manager (apt-get, as root), so that the tests of roc's zsh/fish setup
+#                       scripts and completions, of roc tui in a real terminal, of --compiler-cache ccache
+#                       and of roc launch's processes on other hosts (an sshd the test starts) run
 #                       instead of skipping; CI sets it (.ci/run). Without
 #                       it, missing tools are only reported. roc itself needs none of them.
 # Environment: PYTHON (interpreter that creates the venv, default python3),
@@ -19,22 +25,37 @@
 set -euo pipefail
 
 ROOT="$(cd -- "$(dirname -- "${BASH_SOURCE[0]}")/.." && pwd -P)"
-VENV="$ROOT/.venv"
-VPY="$VENV/bin/python"
-STAMP="$VENV/.roc-setup-stamp"
 PYTHON="${PYTHON:-python3}"
 
 say() { printf 'setup: %s\n' "$*" >&2; }
 die() { printf 'setup: error: %s\n' "$*" >&2; exit 1; }
+
+DISTRO=jazzy
+case "${1:-}" in
+    --distro) DISTRO="${2:-}"; shift 2 || die "--distro needs a name (jazzy or kilted)" ;;
+    --distro=*) DISTRO="${1#--distro=}"; shift ;;
+    "") ;;
+    *) die "unknown argument '$1' (usage: bash scripts/setup.sh [--distro jazzy|kilted])" ;;
+esac
+[ "$#" -eq 0 ] || die "unknown argument '$1' (usage: bash scripts/setup.sh [--distro jazzy|kilted])"
+case "$DISTRO" in
+    jazzy|kilted) ;;
+    *) die "roc is set up for the ROS 2 distributions jazzy and kilted, not '$DISTRO'" ;;
+esac
+REQUIREMENTS="$ROOT/requirements/ros-$DISTRO.txt"
+# Jazzy, the default, in .venv; any other distribution in a venv of its own
+if [ "$DISTRO" = jazzy ]; then VENV="$ROOT/.venv"; else VENV="$ROOT/.venv-$DISTRO"; fi
+VPY="$VENV/bin/python"
+STAMP="$VENV/.roc-setup-stamp"
 # pip, without the machine-wide config's warnings about absent local index folders.
 pip_q() {
     "$VPY" -m pip "$@" 2>&1 \
         | { grep -v -E "^WARNING: Location 'file://[^']*' is ignored: it is neither a file nor a directory\.\$" || true; } >&2
 }
 
-# One setup at a time per checkout (e.g. two test runs started together).
+# One setup at a time per venv (e.g. two test runs started together).
 if command -v flock >/dev/null 2>&1; then
-    LOCK="${TMPDIR:-/tmp}/roc-setup-$(printf '%s' "$ROOT" | sha256sum | cut -c1-16).lock"
+    LOCK="${TMPDIR:-/tmp}/roc-setup-$(printf '%s' "$VENV" | sha256sum | cut -c1-16).lock"
     exec 9>"$LOCK"
     flock 9
 fi
@@ -43,7 +64,7 @@ fi
 stamp_inputs() {
     local f
     for f in "$ROOT/scripts/setup.sh" "$ROOT/scripts/fix_ros_wheels.py" "$ROOT/pyproject.toml" "$ROOT/bin/roc" \
-             "$ROOT"/requirements/*.txt; do
+             "$REQUIREMENTS"; do
         [ -f "$f" ] && printf '%s\n' "${f#"$ROOT"/}" && cat -- "$f"
     done
     # the interpreter the venv runs on
@@ -61,12 +82,14 @@ EOF
 }
 
 # ---- test-time tools (opt-in: their tests skip without them): the shells the tests source roc's
-# setup scripts in, tmux, which runs roc tui in a real terminal, and ccache (a compiler cache). Installed only with
+# setup scripts in, tmux, which runs roc tui in a real terminal, ccache (a compiler cache) and sshd (the
+# SSH server roc launch's remote-process tests start on localhost, never as a service). Installed only with
 # ROC_SETUP_TEST_TOOLS=1; otherwise a full set-up says which are missing.
 setup_test_tools() {
     local missing=() tool
-    for tool in zsh fish tmux ccache; do
-        command -v "$tool" >/dev/null 2>&1 || missing+=("$tool")
+    # command:package (the package is the command's name unless given)
+    for tool in zsh fish tmux ccache sshd:openssh-server; do
+        command -v "${tool%%:*}" >/dev/null 2>&1 || missing+=("${tool#*:}")
     done
     [ "${#missing[@]}" -gt 0 ] || return 0
     if [ "${ROC_SETUP_TEST_TOOLS:-0}" != 1 ]; then
@@ -112,13 +135,13 @@ rm -f -- "$STAMP"
 say "upgrading pip"
 pip_q install -q --upgrade pip
 
-say "installing roc (editable, with the test extra) and the ROS 2 Jazzy wheels"
+say "installing roc (editable, with the test extra) and the ROS 2 $DISTRO wheels (${REQUIREMENTS#"$ROOT"/})"
 # 'compat' puts the checkout on sys.path with a plain .pth entry; the default editable mode adds an
 # import hook that costs ~10 ms at every roc start. Should setuptools drop 'compat', use the default.
 # (setuptools' notice that 'compat' is transitional is left out: it is the comment above)
 PYTHONWARNINGS="ignore:Compat editable installs" \
-    pip_q install -q --config-settings editable_mode=compat -e "$ROOT[test]" -r "$ROOT/requirements/ros-jazzy.txt" \
-    || pip_q install -q -e "$ROOT[test]" -r "$ROOT/requirements/ros-jazzy.txt"
+    pip_q install -q --config-settings editable_mode=compat -e "$ROOT[test]" -r "$REQUIREMENTS" \
+    || pip_q install -q -e "$ROOT[test]" -r "$REQUIREMENTS"
 
 # ---- the colcon oracle's setuptools -------------------------------------------------------
 # colcon reads a setup.py through the setuptools it runs with, and setuptools 72+ (which grpcio-tools
@@ -153,4 +176,4 @@ fi
 [ -x "$VENV/bin/colcon" ] || die "$VENV/bin/colcon is missing"
 
 want_stamp >"$STAMP"
-say "done in $((SECONDS - start)) s: run roc as $VENV/bin/roc (or 'source .venv/bin/activate')"
+say "done in $((SECONDS - start)) s: ROS 2 $DISTRO; run roc as $VENV/bin/roc (or 'source ${VENV#"$ROOT"/}/bin/activate')"

@@ -1,13 +1,23 @@
 #!/usr/bin/env bash
-# Set up the environment (scripts/setup.sh, quick when already done), then run the whole
-# test suite on 2 cores with pytest-xdist. Extra arguments go to pytest, e.g.
+# Set up the environment (scripts/setup.sh, quick when already done), then run the test suite on 2 cores
+# with pytest-xdist. Extra arguments go to pytest, e.g.
 #   bash scripts/test.sh -k graph -x
+# --distro NAME (first) runs on that ROS 2 distribution's venv instead of Jazzy's .venv:
+#   bash scripts/test.sh --distro kilted          the distribution suite (tests marked distro) on Kilted
+# (tests/conftest.py: on a distribution other than Jazzy only the tests marked distro run).
 set -euo pipefail
 
 ROOT="$(cd -- "$(dirname -- "${BASH_SOURCE[0]}")/.." && pwd -P)"
 cd "$ROOT"
 
-bash "$ROOT/scripts/setup.sh"
+distro=jazzy
+case "${1:-}" in
+    --distro) distro="${2:?test: --distro needs a name (jazzy or kilted)}"; shift 2 ;;
+    --distro=*) distro="${1#--distro=}"; shift ;;
+esac
+if [ "$distro" = jazzy ]; then venv="$ROOT/.venv"; else venv="$ROOT/.venv-$distro"; fi
+
+bash "$ROOT/scripts/setup.sh" --distro "$distro"
 
 rc=0
 # loadgroup: tests marked xdist_group("busy_or_timing") share one worker, so the bridge tests' busy
@@ -17,7 +27,7 @@ paths=(tests)
 for arg in "$@"; do
     if [ -e "${arg%%::*}" ]; then paths=(); fi
 done
-"$ROOT/.venv/bin/python" -m pytest -n 2 --dist loadgroup "${paths[@]}" "$@" </dev/null || rc=$?
+"$venv/bin/python" -m pytest -n 2 --dist loadgroup "${paths[@]}" "$@" </dev/null || rc=$?
 if [ "$rc" -eq 5 ]; then
     echo "test: error: pytest collected no tests (exit code 5); treating it as a failure" >&2
     exit 1

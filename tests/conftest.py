@@ -5,12 +5,21 @@
   ignored signal stays ignored in every child, a handled one is reset to its default.
 - Tests skipped because an oracle is missing (tests/helpers/oracles.py) are summed up at the end of the run,
   one line per reason, so that a checkout without ``../shared`` says what it did not test.
+- The whole suite runs on Jazzy (.venv). On another distribution (``bash scripts/test.sh --distro
+  kilted``: .venv-kilted) only the distribution suite runs, the tests marked ``distro``: each area end to
+  end; the others are distribution-independent and run once, on Jazzy. ROC_TEST_UNMARKED=1 runs them too.
 """
 
+import os
 import signal
 from collections import Counter
 
 import pytest
+
+from roc import distribution
+
+FULL_SUITE_DISTRO = "jazzy"
+DISTRO = distribution.current({}).name  # the venv's (tests/helpers/build.py: DISTRO)
 
 if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
@@ -20,6 +29,21 @@ def _skip_reason(report) -> str:
     longrepr = report.longrepr
     reason = longrepr[2] if isinstance(longrepr, tuple) and len(longrepr) == 3 else str(longrepr)
     return reason.removeprefix("Skipped: ")
+
+
+def pytest_collection_modifyitems(config, items) -> None:
+    if DISTRO == FULL_SUITE_DISTRO or os.environ.get("ROC_TEST_UNMARKED") == "1":
+        return
+    kept = [item for item in items if item.get_closest_marker("distro")]
+    deselected = [item for item in items if not item.get_closest_marker("distro")]
+    if deselected:
+        config.hook.pytest_deselected(items=deselected)
+        items[:] = kept
+
+
+def pytest_report_header(config) -> str:
+    suite = "the whole suite" if DISTRO == FULL_SUITE_DISTRO else "the distribution suite (tests marked distro)"
+    return f"ROS 2 {DISTRO}: {suite}"
 
 
 def pytest_terminal_summary(terminalreporter) -> None:
@@ -38,3 +62,18 @@ def launch_demo_prefix(tmp_path_factory):
     from helpers.launch import build_demo
 
     return build_demo(tmp_path_factory.mktemp("launch_demo"))
+
+
+@pytest.fixture(scope="session")
+def example_workspace(tmp_path_factory):
+    """workspaces/example built by roc once per test worker (its tests and the manual's live examples share
+    it: mark them ``xdist_group("example_workspace")`` to build it once). Read it, never change it."""
+    import shutil
+
+    from helpers.build import REPO, roc
+
+    workspace = tmp_path_factory.mktemp("example")
+    shutil.copytree(REPO / "workspaces" / "example" / "src", workspace / "src")
+    result = roc("work", "build", "--parallel-workers", "2", cwd=workspace)
+    assert result.returncode == 0, result.stdout + result.stderr
+    return workspace

@@ -1,12 +1,16 @@
 """``roc bag convert``: input bags rewritten into output bags as rosbag2's output-options YAML
 describes them (``output_bags``: each a uri with StorageOptions and RecordOptions: storage, split
-sizes and durations, compression, topic and service selection, ``start_time_ns``/``end_time_ns``).
-The inputs are read once, merged in time order, and each message goes to every output that takes
-it. Definitions come from the input bags, else from the environment."""
+sizes and durations, compression, topic and service selection, ``start_time_ns``/``end_time_ns``,
+``repeat_transient_local_messages`` and ``repeat_all_transient_local_depth`` as rosbag2 names them).
+Per topic, an output may also keep a range of messages (``topic_message_ranges``: first and last
+index, counted from 0 over the inputs, as ros2/rosbag2#2500 proposes) or of log times
+(``topic_time_ranges``: first and last nanosecond). The inputs are read once, merged in time order,
+and each message goes to every output that takes it. Definitions come from the input bags, else from
+the environment."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -25,7 +29,9 @@ _KNOWN = {"uri", "storage_id", "max_bagfile_size", "max_bagfile_duration", "max_
           "exclude", "exclude_regex", "node_prefix", "compression_mode", "compression_format",
           "compression_queue_size", "compression_threads", "compression_threads_priority",
           "topic_qos_profile_overrides", "include_hidden_topics", "include_unpublished_topics", "ignore_leaf_topics",
-          "start_paused", "use_sim_time", "disable_keyboard_controls", *_LISTS}
+          "start_paused", "use_sim_time", "disable_keyboard_controls", "repeat_transient_local_messages",
+          "repeat_all_transient_local_depth", "topic_message_ranges", "topic_time_ranges", *_LISTS}
+Range = tuple[int, int]  # first and last, both kept
 
 
 @dataclass
@@ -35,6 +41,52 @@ class Output:
     selection: Selection
     start: int | None
     end: int | None
+    where: str = ""  # the output's place in its YAML file, for errors
+    message_ranges: dict[str, Range] = field(default_factory=dict)
+    time_ranges: dict[str, Range] = field(default_factory=dict)
+
+    def keeps(self, topic: str, index: int, log_time: int) -> bool:
+        """Whether the message ``index`` of ``topic`` (counted over the inputs) is in its ranges."""
+        first, last = self.message_ranges.get(topic, (0, index))
+        start, end = self.time_ranges.get(topic, (log_time, log_time))
+        return first <= index <= last and start <= log_time <= end
+
+
+def _integer(value: Any, where: str, least: int = 0) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < least:
+        raise UsageError(f"{where}: expected a{' positive' if least else ' non-negative'} integer, got {value!r}")
+    return value
+
+
+def _ranges(entry: dict, key: str, where: str) -> dict[str, Range]:
+    """``{topic: [first, last]}`` (or ``{first, last}``) of ``entry[key]``."""
+    given = entry.get(key) or {}
+    if not isinstance(given, dict):
+        raise UsageError(f"{where}: {key} must map topic names to [first, last]")
+    ranges = {}
+    for topic, bounds in given.items():
+        at = f"{where}: {key}: {topic}"
+        if isinstance(bounds, dict) and set(bounds) == {"first", "last"}:
+            bounds = [bounds["first"], bounds["last"]]
+        if not isinstance(bounds, list) or len(bounds) != 2:
+            raise UsageError(f"{at}: expected [first, last]")
+        first, last = _integer(bounds[0], at), _integer(bounds[1], at)
+        if first > last:
+            raise UsageError(f"{at}: the first ({first}) is after the last ({last})")
+        ranges[str(topic)] = (first, last)
+    return ranges
+
+
+def _repeat(entry: dict, where: str) -> tuple[dict[str, int], int]:
+    """rosbag2's ``repeat_transient_local_messages`` ({topic: depth}) and
+    ``repeat_all_transient_local_depth``."""
+    given = entry.get("repeat_transient_local_messages") or {}
+    if not isinstance(given, dict):
+        raise UsageError(f"{where}: repeat_transient_local_messages must map topic names to depths")
+    depths = {str(topic): _integer(depth, f"{where}: repeat_transient_local_messages: {topic}", least=1)
+              for topic, depth in given.items()}
+    every = _integer(entry.get("repeat_all_transient_local_depth") or 0, f"{where}: repeat_all_transient_local_depth")
+    return depths, every
 
 
 def _output(entry: Any, where: str) -> Output:
@@ -48,12 +100,14 @@ def _output(entry: Any, where: str) -> Output:
             raise UsageError(f"{where}: {key} must be a list")
     every = bool(entry.get("all"))
     mode = str(entry.get("compression_mode") or "none").lower()
+    repeated, repeat_all = _repeat(entry, where)
     options = WriteOptions(storage=str(entry.get("storage_id") or DEFAULT_STORAGE),
                            max_bag_size=int(entry.get("max_bagfile_size") or 0),
                            max_bag_duration=int(entry.get("max_bagfile_duration") or 0) * 1_000_000_000,
                            compression_mode=mode, compression_format=str(entry.get("compression_format") or ""),
                            preset=str(entry.get("storage_preset_profile") or "none"),
-                           custom_data={str(k): str(v) for k, v in (entry.get("custom_data") or {}).items()})
+                           custom_data={str(k): str(v) for k, v in (entry.get("custom_data") or {}).items()},
+                           repeat_transient_local=repeated, repeat_all_transient_local=repeat_all)
     try:
         check_options(options)
         selection = Selection(
@@ -66,7 +120,8 @@ def _output(entry: Any, where: str) -> Output:
         raise UsageError(f"{where}: {error}") from None
     start, end = int(entry.get("start_time_ns", -1)), int(entry.get("end_time_ns", -1))
     return Output(Path(str(entry["uri"])), options, selection, start if start >= 0 else None,
-                  end if end >= 0 else None)
+                  end if end >= 0 else None, where, _ranges(entry, "topic_message_ranges", where),
+                  _ranges(entry, "topic_time_ranges", where))
 
 
 def read_output_options(path: Path) -> list[Output]:
@@ -101,6 +156,18 @@ def _topics(bags: list[Bag]) -> tuple[dict[str, Topic], dict[str, Definition]]:
     return topics, definitions
 
 
+def _check_ranges(outputs: list[Output], counts: dict[str, int]) -> None:
+    """A UsageError for a range of a topic the inputs lack, or past its last message (as rosbag2#2500)."""
+    for output in outputs:
+        for key, ranges in (("topic_message_ranges", output.message_ranges), ("topic_time_ranges", output.time_ranges)):
+            for topic, (_, last) in ranges.items():
+                if topic not in counts:
+                    raise UsageError(f"{output.where}: {key}: {topic}: no input bag has this topic")
+                if key == "topic_message_ranges" and last >= counts[topic]:
+                    raise UsageError(f"{output.where}: {key}: {topic}: message {last} is past the last one "
+                                     f"(the inputs hold {counts[topic]}, numbered from 0)")
+
+
 def convert(inputs: list[tuple[str, str | None]], outputs: list[Output]) -> list[BagMetadata]:
     """Write every output bag; returns their metadata."""
     import heapq
@@ -110,6 +177,11 @@ def convert(inputs: list[tuple[str, str | None]], outputs: list[Output]) -> list
         for uri, storage in inputs:
             bags.append(Bag(uri, storage))
         topics, definitions = _topics(bags)
+        counts: dict[str, int] = {}
+        for bag in bags:
+            for topic, count in bag.metadata.topics:
+                counts[topic.name] = counts.get(topic.name, 0) + count
+        _check_ranges(outputs, counts)
         writers: list[tuple[Output, BagWriter, set[str]]] = []
         for output in outputs:
             writer = BagWriter(output.uri, output.options)
@@ -119,10 +191,16 @@ def convert(inputs: list[tuple[str, str | None]], outputs: list[Output]) -> list
             writers.append((output, writer, taken))
         streams = [bag.messages() for bag in bags]
         merged = streams[0] if len(streams) == 1 else heapq.merge(*streams, key=lambda m: m.log_time)
+        indices = dict.fromkeys(topics, 0)  # the next message's index, per topic
         for message in merged:
+            index = indices[message.topic]
+            indices[message.topic] += 1
             for output, writer, taken in writers:
-                if message.topic in taken and (output.start is None or message.log_time >= output.start) and (
-                        output.end is None or message.log_time <= output.end):
+                if message.topic not in taken or not output.keeps(message.topic, index, message.log_time):
+                    continue
+                if output.start is not None and message.log_time < output.start:
+                    writer.remember(message.topic, message.data, message.log_time, message.publish_time)
+                elif output.end is None or message.log_time <= output.end:
                     writer.write(message.topic, message.data, message.log_time, message.publish_time)
         return [writer.close() for _, writer, _ in writers]
     finally:

@@ -1,17 +1,17 @@
 """A bag's metadata as rosbag2 keeps it (``metadata.yaml``, versions 4 to 9), read and written.
 
-roc writes version 9, Jazzy's: offered QoS profiles as a list, type description hashes, per-file
-information, custom data and the ROS distribution."""
+roc writes version 9, as rosbag2 does in Jazzy and in Kilted: offered QoS profiles as a list, type
+description hashes, per-file information, custom data and the ROS distribution (roc.distribution's)."""
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import yaml
 
+from roc import distribution
 from roc.bag.qos import parse_profiles
 from roc.errors import RocError
 
@@ -75,8 +75,8 @@ class BagMetadata:
 
 
 def ros_distro() -> str:
-    """The distribution written into new bags: $ROS_DISTRO, else Jazzy (roc's rclpy)."""
-    return os.environ.get("ROS_DISTRO") or "jazzy"
+    """The distribution written into new bags: the one roc works with (roc.distribution)."""
+    return distribution.current().name
 
 
 # ---- reading ------------------------------------------------------------------------------------

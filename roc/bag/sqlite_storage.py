@@ -3,11 +3,16 @@ version 4, Jazzy's) ``schema``, ``metadata`` and ``message_definitions`` tables.
 schema table, fewer topic columns) are read too.
 
 roc writes with a write-ahead log and commits every COMMIT_MESSAGES messages (or on ``flush``), so a
-killed recording keeps every committed message; rosbag2's ``resilient`` preset asks for the same."""
+killed recording keeps every committed message; rosbag2's ``resilient`` preset asks for the same.
+
+Reading writes nothing beside the file (``read_only_uri``): a read-only connection to a write-ahead-log
+file would otherwise leave ``-shm`` and ``-wal`` files next to it, and could not open a file in a
+read-only place at all."""
 
 from __future__ import annotations
 
 import sqlite3
+import urllib.parse
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
@@ -37,6 +42,53 @@ _CREATE = (
 )
 
 
+WAL_MODE = 2  # bytes 18 and 19 of a sqlite3 file's header: 2 in write-ahead-log mode
+
+
+def _in_wal_mode(path: Path) -> bool:
+    with open(path, "rb") as handle:
+        header = handle.read(20)
+    return len(header) == 20 and header[18] == header[19] == WAL_MODE
+
+
+def _in_use(index: Path) -> bool:
+    """Whether a connection holds a ``-shm`` index open: sqlite's connections keep a read lock on its
+    byte 128 (the "DMS" byte) while they have it, so a recording still writing holds one."""
+    import fcntl
+    import os
+    import struct
+
+    try:
+        descriptor = os.open(index, os.O_RDONLY)
+    except OSError:
+        return False
+    try:
+        flock = "hhqqi4x"  # struct flock: type, whence, start, length, pid
+        answer = fcntl.fcntl(descriptor, fcntl.F_GETLK, struct.pack(flock, fcntl.F_WRLCK, 0, 128, 1, 0))
+        return struct.unpack(flock, answer)[0] != fcntl.F_UNLCK
+    except OSError:
+        return True
+    finally:
+        os.close(descriptor)
+
+
+def read_only_uri(path: Path) -> tuple[str, bool]:
+    """The URI that opens ``path`` for reading without writing beside it, and whether the connection
+    must then ask for exclusive locking. A file in rollback-journal mode opens read-only (``mode=ro``).
+    A file in write-ahead-log mode that a recording is still writing shares its ``-shm`` index with
+    it. Otherwise, without a log (or an empty one) the file alone holds everything and is read as
+    ``immutable``; with one (a killed recording's last commits), the log is read with its index in
+    this process's memory: exclusive locking before the first read (sqlite then neither creates a
+    ``-shm`` nor writes one left behind), and no file locks (``unix-none``), since no writer is left."""
+    base = "file:" + urllib.parse.quote(str(path.absolute())) + "?mode=ro"
+    if not _in_wal_mode(path) or _in_use(path.with_name(path.name + "-shm")):
+        return base, False
+    log = path.with_name(path.name + "-wal")
+    if not log.exists() or log.stat().st_size == 0:
+        return base + "&immutable=1", False
+    return base + "&vfs=unix-none", True
+
+
 def _columns(connection: sqlite3.Connection, table: str) -> set[str]:
     return {row[1] for row in connection.execute(f"PRAGMA table_info({table})")}
 
@@ -49,8 +101,13 @@ class SqliteFile:
         if not path.is_file():
             raise BagError(f"{path}: no such file")
         try:
-            self._db = sqlite3.connect(f"file:{path}?mode=ro", uri=True, check_same_thread=False)
+            uri, exclusive = read_only_uri(path)
+            self._db = sqlite3.connect(uri, uri=True, check_same_thread=False)
+            if exclusive:
+                self._db.execute("PRAGMA locking_mode=EXCLUSIVE")
             tables = {row[0] for row in self._db.execute("SELECT name FROM sqlite_master WHERE type='table'")}
+        except OSError as error:
+            raise BagError(f"{path}: cannot read it ({error.strerror})") from None
         except sqlite3.DatabaseError as error:
             raise BagError(f"{path}: not a sqlite3 bag ({error})") from None
         if not {"topics", "messages"} <= tables:

@@ -1,11 +1,18 @@
 """Writing a bag as rosbag2 does: a directory ``NAME`` with ``NAME_0.mcap`` (or ``.db3``),
 ``NAME_1...`` after each split (by size or duration), each file zstd-compressed when it is closed
 (``file`` mode) or each message compressed (``message`` mode, sqlite3 only as in rosbag2), and
-``metadata.yaml`` written at the end (and kept inside each file, as rosbag2's storages do)."""
+``metadata.yaml`` written at the end (and kept inside each file, as rosbag2's storages do).
+
+Transient local topics may be repeated (rosbag2's ``--repeat-transient-local``): the writer keeps the
+latest messages of each such topic and begins every new file with them, stamped with the time of the
+message that opens the file, so each file plays alone (``/tf_static``, ``/map``). rosbag2 stamps them
+with the previous file's last time; the next message's time keeps the files' time spans apart, so a
+reader still reads split files one after the other."""
 
 from __future__ import annotations
 
 import errno
+from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -39,6 +46,18 @@ class WriteOptions:
     compression_format: str = ""  # zstd
     preset: str = "none"
     custom_data: dict[str, str] = field(default_factory=dict)
+    # Repeated at the start of each file: the latest N messages of these topics (rosbag2's
+    # repeat_transient_local_messages), and of every topic offered transient local when N > 0
+    # (rosbag2's repeat_all_transient_local_depth).
+    repeat_transient_local: dict[str, int] = field(default_factory=dict)
+    repeat_all_transient_local: int = 0
+
+    def repeat_depth(self, topic: Topic) -> int:
+        """How many of ``topic``'s latest messages begin each file (0: none)."""
+        if topic.name in self.repeat_transient_local:
+            return self.repeat_transient_local[topic.name]
+        latched = any(profile.get("durability") == "transient_local" for profile in topic.offered_qos_profiles)
+        return self.repeat_all_transient_local if latched else 0
 
 
 def check_options(options: WriteOptions) -> None:
@@ -63,6 +82,10 @@ def check_options(options: WriteOptions) -> None:
         raise UsageError(f"--max-bag-size must be at least {MIN_SPLIT_SIZE} bytes (as in rosbag2)")
     if options.max_bag_size < 0 or options.max_bag_duration < 0:
         raise UsageError("--max-bag-size and --max-bag-duration may not be negative")
+    depths = [*options.repeat_transient_local.values(), options.repeat_all_transient_local]
+    if any(isinstance(depth, bool) or not isinstance(depth, int) or depth < 0 for depth in depths) or any(
+            depth == 0 for depth in options.repeat_transient_local.values()):
+        raise UsageError("--repeat-transient-local: each depth must be a positive number of messages")
 
 
 def _disk_error(error: OSError, path: Path) -> BagError:
@@ -101,6 +124,8 @@ class BagWriter:
         self._paths: list[str] = []
         self._file: McapWriter | SqliteWriter | None = None
         self._file_start = self._file_end = self._file_count = 0
+        self._latest: dict[str, deque[tuple[bytes, int, int]]] = {}  # of repeated topics, uncompressed
+        self.repeated = 0  # messages written again at the start of a file
         self._compress = (compression.MessageCompressor() if options.compression_mode == "message" else None)
         self.closed = False
         self.failed = False  # a write failed: what the files hold may be less than what was written
@@ -129,6 +154,9 @@ class BagWriter:
             return
         self._topics[topic.name] = (topic, definition)
         self._counts.setdefault(topic.name, 0)
+        depth = self.options.repeat_depth(topic)
+        if depth:
+            self._latest[topic.name] = deque(maxlen=depth)
         if self._file is not None:
             try:
                 self._file.add_topic(topic, definition)
@@ -143,6 +171,23 @@ class BagWriter:
         elif self._should_split(log_time):
             self.split()
             self._file = self._open_file()
+        if not self._file_count:  # a new file begins with the repeated topics' latest messages
+            kept = sorted(((kept_time, name, kept_data) for name, latest in self._latest.items()
+                           for kept_data, kept_time, _ in latest), key=lambda item: item[0])
+            for _, name, kept_data in kept:
+                self._put(name, kept_data, log_time, log_time)
+            self.repeated += len(kept)
+        self._put(topic, data, log_time, publish_time)
+        self.remember(topic, data, log_time, publish_time)
+
+    def remember(self, topic: str, data: bytes, log_time: int, publish_time: int = 0) -> None:
+        """Keep a message of a repeated topic for the start of the next file, without writing it
+        (``convert`` remembers what comes before an output's start time)."""
+        if topic in self._latest:
+            self._latest[topic].append((data, log_time, publish_time))
+
+    def _put(self, topic: str, data: bytes, log_time: int, publish_time: int) -> None:
+        assert self._file is not None
         if self._compress is not None:
             data = self._compress(data)
         try:

@@ -40,7 +40,14 @@ def _has_file(directory: Path) -> bool:
 
 @lru_cache(maxsize=1)
 def multiarch() -> str | None:
-    """The multiarch triplet (e.g. x86_64-linux-gnu) that colcon-ros uses for pkg-config paths."""
+    """The multiarch triplet (e.g. x86_64-linux-gnu) that colcon-ros uses for pkg-config paths: Python's
+    own (Debian's and most builds know it), else gcc's (a package restored from a cache is finished
+    without running a compiler)."""
+    import sysconfig
+
+    known = sysconfig.get_config_var("MULTIARCH")
+    if known:
+        return str(known)
     try:
         return subprocess.run(["gcc", "-print-multiarch"], capture_output=True, text=True, check=True).stdout.strip()
     except (OSError, subprocess.CalledProcessError):

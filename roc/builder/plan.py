@@ -6,8 +6,9 @@ Each selected package gets a ``build`` task; a package with protobuf sources als
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 from roc.builder.environment import ENVIRONMENT_FILE, build_environment
 from roc.builder.finish import finish_package
@@ -38,15 +39,22 @@ if TYPE_CHECKING:
     from roc.remote_cache.keys import RemoteKeys
 
 
+class RemoteBuilds(Protocol):
+    """Where packages are built instead of here (roc.cluster.remote_build.ClusterBuilds)."""
+
+    def action(self, build: _PackageBuild) -> Callable[[TaskContext], object]: ...
+
+
 def plan_build(
     workspace: Workspace, options: BuildOptions, jobserver: Jobserver | None, weights: dict[str, float],
-    remote: RemoteCache | None = None, compiler: CompilerCache | None = None,
+    remote: RemoteCache | None = None, compiler: CompilerCache | None = None, cluster: RemoteBuilds | None = None,
 ) -> list[Task]:
     """One ``build`` task per selected package, and one ``idl`` task before it for a package with
     protobuf sources. Whether a task is up to date is checked when it is dispatched (what it waits for
     done by then). With a ``remote`` cache, a package that is not up to date is first looked up there
     (the task's ``restore``), and uploaded after it is built when the cache is writable. A ``compiler``
-    cache is the compiler launcher of every CMake package."""
+    cache is the compiler launcher of every CMake package. With a ``cluster``, a package that is not
+    up to date and not in the remote cache is built on the cluster (its task's action)."""
     selected = workspace.selected
     fingerprints = Fingerprints(workspace, options)
     remote_keys = None
@@ -72,7 +80,7 @@ def plan_build(
         tasks.append(Task(
             name=package.name,
             dependencies=waits_for,
-            action=build.run,
+            action=cluster.action(build) if cluster is not None else build.run,
             weight=weights.get(package.name, 1.0),
             check=build.check,
             restore=build.restore if remote is not None else None,
@@ -111,6 +119,12 @@ class _PackageBuild:
         if self.remote_key is None:
             missing = self.remote_keys.missing_dependency(self.state.parts) if self.remote_keys else None
             return f"no remote cache key (dependency '{missing}' has none: build it with the remote cache on)"
+        return self.fetch(context)
+
+    def fetch(self, context: TaskContext) -> str | None:
+        """Restore the package's remote key from the remote cache, recorded as built when whole: None
+        when done, else why not."""
+        assert self.remote is not None and self.state is not None and self.remote_key is not None
         build_dir = self.options.build_base / self.package.name
         write_state(build_dir, None, self.state.files)  # until restored whole
         missed = self.remote.restore(self.package, self.remote_key, context)

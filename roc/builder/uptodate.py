@@ -161,6 +161,14 @@ def explain(workspace: Workspace, options: BuildOptions, remote=None) -> list[tu
     return explained
 
 
+def anything_to_build(workspace: Workspace, options: BuildOptions) -> bool:
+    """Whether a build would build (or restore) any selected package (without building anything)."""
+    if forced_reasons(options):
+        return bool(workspace.selected)
+    fingerprints = Fingerprints(workspace, options)
+    return any(stale_reasons(p, fingerprints.compute(p), options) for p in workspace.selected_in_order())
+
+
 def fingerprint_packages(workspace: Workspace, options: BuildOptions) -> dict[str, PackageState]:
     """The state of every selected package now, by name."""
     fingerprints = Fingerprints(workspace, options)

@@ -44,7 +44,7 @@ from typing import Any
 
 import tomllib
 
-from roc.config import ROC_TOML, ConfigError, check_table, header_lines, key_line, type_names
+from roc.config import ROC_TOML, ConfigError, array_item_lines, check_table, header_lines, key_line, type_names
 from roc.errors import UsageError
 from roc.messages import did_you_mean
 
@@ -114,18 +114,21 @@ def load_checks(path: Path) -> CheckFile:
             raise ConfigError(path, key, f"expected {type_names(SETTINGS[key])}, got {value!r}", line)
     checks.timeout = float(table.get("timeout", checks.timeout))
     checks.rate_window = float(table.get("rate-window", checks.rate_window))
-    for node in table.get("nodes", []):
+    nodes_line = key_line(text, header, "nodes")
+    node_lines = array_item_lines(text, nodes_line) if nodes_line != header else []
+    for index, node in enumerate(table.get("nodes", [])):
+        line = node_lines[index] if index < len(node_lines) else nodes_line  # each name's own line
         if not isinstance(node, str):
-            raise ConfigError(path, "nodes", f"expected node names, got {node!r}", key_line(text, header, "nodes"))
-        checks.expectations.append(Expectation("node", node, where=f"{path}:{key_line(text, header, 'nodes')}"))
+            raise ConfigError(path, "nodes", f"expected node names, got {node!r}", line)
+        checks.expectations.append(Expectation("node", node, where=f"{path}:{line}"))
     for kind, schema in SCHEMA.items():
         entries = table.get(kind, [])
         if isinstance(entries, dict):
             entries = [entries]  # [check.topic] written once, as a table
-        starts = header_lines(text, f"check.{kind}")
         if not isinstance(entries, list):
             raise ConfigError(path, f"check.{kind}", f"write each as a [[check.{kind}]] table",
                               key_line(text, header, kind))
+        starts = _entry_lines(text, header, kind)
         for index, entry in enumerate(entries):
             start = starts[index] if index < len(starts) else header
             checks.expectations.append(_expectation(path, text, kind, schema, entry, start))
@@ -135,6 +138,13 @@ def load_checks(path: Path) -> CheckFile:
         if labels[expectation.label] > 1:
             expectation.suffix = f" ({labels[expectation.label]})"
     return checks
+
+
+def _entry_lines(text: str, header: int, kind: str) -> list[int]:
+    """The line of each entry of ``kind``: each ``[[check.topic]]`` header, or each inline table of
+    ``topic = [{...}, ...]`` in [check] (as roc graph snapshot writes services and actions)."""
+    inline = key_line(text, header, kind)
+    return array_item_lines(text, inline) if inline != header else header_lines(text, f"check.{kind}")
 
 
 def _expectation(path: Path, text: str, kind: str, schema: dict, entry: dict, start: int) -> Expectation:

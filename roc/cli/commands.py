@@ -33,6 +33,7 @@ COMMANDS = (
     (("work", "cache"), (), "work.cache", "CI caching of build results: cache key | export PATH | import PATH"),
     (("work", "config"), (), "work.config", "print the effective configuration and where each value comes from"),
     (("work", "create"), (), "work.create", "create a new package from a template (like ros2 pkg create)"),
+    (("work", "worker"), (), "work.worker", "run a Dask worker that builds and tests packages for --cluster"),
     (("topic",), (), None, "ROS topics"),
     (("topic", "list"), (), "topic.list", "list the topics of the ROS graph"),
     (("topic", "info"), (), "topic.info", "a topic's type and endpoints (-v: QoS and compatibility checks)"),

@@ -183,3 +183,30 @@ def qos_options(args: argparse.Namespace) -> dict:
     return {"profile": args.qos_profile, "depth": args.qos_depth,
             "liveliness_lease_seconds": args.qos_liveliness_lease_duration_seconds,
             **{policy: getattr(args, f"qos_{policy}") for policy in QOS_POLICIES}}
+
+
+def add_content_filter_arguments(parser: argparse.ArgumentParser) -> None:
+    """ros2's ``--content-filter`` of ``topic echo``, ``hz`` and ``bw`` (ros2/ros2cli#1213)."""
+    parser.add_argument("--content-filter", dest="content_filter_expr", metavar="EXPR",
+                        help="only messages that pass this DDS content filter expression, e.g. \"data LIKE "
+                             "'%%hello%%'\" or \"position.x > %%0\": evaluated by the middleware where it "
+                             "can (the publishers then send nothing else), else by roc")
+    parser.add_argument("--content-filter-params", nargs="*", default=[], metavar="PARAM",
+                        help="the values of %%0, %%1, ... in --content-filter (a bare word is a string)")
+
+
+def content_filter_options(args: argparse.Namespace) -> dict | None:
+    """The ``content_filter`` of a stream request, its syntax checked here (a usage error before any
+    subscription); ROC_MIDDLEWARE_CONTENT_FILTER=0 asks roc to filter instead of the middleware."""
+    import os
+
+    from roc.errors import UsageError
+    from roc.ros.content_filter import ContentFilter
+
+    if args.content_filter_expr is None:
+        if args.content_filter_params:
+            raise UsageError("--content-filter-params needs --content-filter")
+        return None
+    ContentFilter(args.content_filter_expr, args.content_filter_params)
+    return {"expression": args.content_filter_expr, "parameters": args.content_filter_params,
+            "middleware": os.environ.get("ROC_MIDDLEWARE_CONTENT_FILTER") != "0"}

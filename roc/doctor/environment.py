@@ -10,15 +10,13 @@ import re
 from collections.abc import Mapping
 from pathlib import Path
 
+from roc import distribution as ros_distribution
 from roc.ament_index import resources
 from roc.doctor.findings import Finding
 from roc.environment import ament_prefixes, path_list
 
 CATEGORY = "environment"
 DEFAULT_RMW = "rmw_fastrtps_cpp"
-# rclpy's major version in each distribution it shipped with (to tell which one a sourced rclpy is)
-RCLPY_DISTROS = {"3": "humble", "4": "iron", "7": "jazzy", "9": "kilted"}
-END_OF_LIFE = ("ardent", "bouncy", "crystal", "dashing", "eloquent", "foxy", "galactic", "iron")
 DISCOVERY_RANGES = ("SUBNET", "LOCALHOST", "OFF", "SYSTEM_DEFAULT")
 DOMAIN_MAX = 232  # Fast DDS derives its UDP ports from the domain; above this they do not fit
 SAFE_DOMAINS = "0-101 and 215-232"  # domains whose ports never meet Linux's ephemeral ones
@@ -36,21 +34,22 @@ def package_version(package: str) -> str | None:
 
 
 def distribution(env: Mapping[str, str]) -> Finding:
-    named = env.get("ROS_DISTRO", "").lower()
-    rclpy = package_version("rclpy")
-    shipped = RCLPY_DISTROS.get(rclpy.split(".")[0]) if rclpy else None
-    if not named and not rclpy:
+    """The ROS 2 distribution (roc.distribution), and whether two are sourced: ROS_DISTRO against the
+    rclpy found, or two rclpys (an overlay built on one distribution chains its rclpy in)."""
+    found = ros_distribution.detected(env)
+    if found is None:
         return Finding(CATEGORY, "distribution", "error", "no ROS 2 found: ROS_DISTRO is not set and no rclpy is in "
                        "the ament index", "source a ROS 2 setup script, e.g. /opt/ros/jazzy/setup.bash")
-    if named and shipped and named != shipped:
-        return Finding(CATEGORY, "distribution", "error", f"ROS_DISTRO is {named} but rclpy {rclpy} is {shipped}'s: "
-                       "two distributions are sourced", "open a new shell and source the setup script of one")
-    name = named or shipped or "unknown"
-    text = f"{name} (rclpy {rclpy})" if rclpy else name
-    if name in END_OF_LIFE:
+    mixed = ros_distribution.mix(env)
+    if mixed:
+        return Finding(CATEGORY, "distribution", "error", f"two distributions are sourced: {mixed}",
+                       "open a new shell and source one distribution's setup script, and workspaces built on it")
+    name, where = found
+    text = f"{name} ({where.split(' in ')[0]})" if where != "ROS_DISTRO" else name
+    if name in ros_distribution.END_OF_LIFE:
         return Finding(CATEGORY, "distribution", "warning", f"{text} is end-of-life: no more fixes or security updates",
-                       "move to a supported distribution such as jazzy")
-    if not named:
+                       "move to a supported distribution such as jazzy or kilted")
+    if not env.get("ROS_DISTRO"):
         return Finding(CATEGORY, "distribution", "info", f"{text}; ROS_DISTRO is not set (ROS 2 from Python wheels?)")
     return Finding(CATEGORY, "distribution", "ok", text)
 

@@ -65,6 +65,7 @@ class TaskFinished(Event):
     duration: float = 0.0
     cached: bool = False  # skipped because it was up to date
     restored: bool = False  # not run: its result was fetched from a cache (after a TaskRestoring)
+    worker: str = ""  # the cluster worker that ran it (roc work build --cluster); empty: it ran here
 
 
 @dataclass(frozen=True)
@@ -101,6 +102,15 @@ class TestFailures(Event):
     result is "test failures", not a failure of the run)."""
 
     __test__ = False
+
+
+@dataclass(frozen=True)
+class TestsNotRun(Event):
+    """A test task's tool ran no test (pytest collected none); the task still finishes, as in colcon.
+    ``reason``: why, e.g. the test files that skipped themselves while pytest imported them."""
+
+    __test__ = False
+    reason: str = ""
 
 
 @dataclass(frozen=True)

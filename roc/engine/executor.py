@@ -26,7 +26,7 @@ from roc.engine.events import (
     TaskStarted,
     Tick,
 )
-from roc.engine.process import TaskCancelled, TaskContext, TaskError
+from roc.engine.process import RanElsewhere, TaskCancelled, TaskContext, TaskError
 from roc.engine.ready import ReadyQueue, Task
 from roc.messages import warn
 
@@ -65,7 +65,7 @@ def _work(task: Task, context: TaskContext, reasons: tuple[str, ...]) -> None:
     try:
         if context.cancelled:
             raise TaskCancelled
-        task.action(context)
+        outcome = task.action(context)
     except TaskCancelled:
         context.emit(TaskAborted(task.name, task.kind, duration=time.monotonic() - start))
     except TaskError as error:
@@ -74,7 +74,10 @@ def _work(task: Task, context: TaskContext, reasons: tuple[str, ...]) -> None:
         context.emit(TaskFailed(task.name, task.kind, duration=time.monotonic() - start,
                                 reason=traceback.format_exc()))
     else:
-        context.emit(TaskFinished(task.name, task.kind, duration=time.monotonic() - start))
+        if isinstance(outcome, RanElsewhere):
+            context.emit(TaskFinished(task.name, task.kind, duration=outcome.duration, worker=outcome.worker))
+        else:
+            context.emit(TaskFinished(task.name, task.kind, duration=time.monotonic() - start))
 
 
 def _check(task: Task) -> list[str] | None:
@@ -85,12 +88,13 @@ def _check(task: Task) -> list[str] | None:
 def execute(
     tasks: Iterable[Task],
     handlers: Iterable[Handler],
-    workers: int,
+    workers: int | Callable[[], int],
     continue_on_error: bool = False,
     kind: str = "build",
     stop: threading.Event | None = None,
 ) -> RunResult:
-    """Run ``tasks`` respecting their dependencies with at most ``workers`` at once (0: no limit).
+    """Run ``tasks`` respecting their dependencies with at most ``workers`` at once (0: no limit; a
+    function: asked again before each dispatch, for a limit that changes, such as a cluster's workers).
 
     Without ``continue_on_error`` the first failure stops the running tasks (aborted) and starts no
     more; with it, only the tasks depending on a failed one are skipped. ``kind`` is the run's own kind
@@ -104,7 +108,11 @@ def execute(
     by_name = {t.key: t for t in tasks}
     ready = ReadyQueue(by_name)
     handlers = list(handlers)
-    limit = workers if workers > 0 else max(1, len(by_name))
+
+    def limit() -> int:
+        count = workers() if callable(workers) else workers
+        return count if count > 0 else max(1, len(by_name))
+
     events: queue.Queue[Event] = queue.Queue()
     running: dict[str, TaskContext] = {}
     result = RunResult()
@@ -158,7 +166,7 @@ def execute(
     previous = {}
     if threading.current_thread() is threading.main_thread():
         previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
-    pool = ThreadPoolExecutor(max_workers=limit, thread_name_prefix="roc-worker")
+    pool = ThreadPoolExecutor(max_workers=max(1, len(by_name)), thread_name_prefix="roc-worker")
     failure: BaseException | None = None
 
     def handle(event: Event) -> None:
@@ -182,7 +190,7 @@ def execute(
             if interrupt.is_set() and not result.interrupted:
                 result.interrupted = stopping = True
                 stop_running()
-            while not stopping and ready.has_ready() and len(running) < limit:
+            while not stopping and ready.has_ready() and len(running) < limit():
                 task = ready.pop()
                 try:
                     reasons = _check(task)
@@ -193,6 +201,7 @@ def execute(
                     handle(TaskFinished(task.name, task.kind, cached=True))
                     continue
                 context = TaskContext(task.name, events.put, task.kind)
+                context.priority = ready.priority(task.key)
                 pool.submit(_work, task, context, tuple(reasons or ()))
                 running[task.key] = context
             if not running:

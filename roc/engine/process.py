@@ -7,6 +7,7 @@ import selectors
 import subprocess
 import threading
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 
 from roc.engine.events import CommandEnded, CommandStarted, Event, TaskOutput
 
@@ -19,6 +20,15 @@ class TaskError(Exception):
 
 class TaskCancelled(Exception):
     """The task was stopped from outside (another task failed, or Ctrl+C)."""
+
+
+@dataclass(frozen=True)
+class RanElsewhere:
+    """What an action returns when another machine did its work (a cluster worker): the worker's name
+    and how long the work took there, which its TaskFinished event carries instead of the time here."""
+
+    worker: str
+    duration: float
 
 
 def stop_process_tree(pid: int, grace: float = STOP_GRACE_SECONDS) -> None:
@@ -54,6 +64,7 @@ class TaskContext:
         self._lock = threading.Lock()
         self._process: subprocess.Popen | None = None
         self.cancelled = False
+        self.priority = 0.0  # how long a chain of work waits on this task (the ready queue's order)
 
     def emit(self, event: Event) -> None:
         self._emit(event)

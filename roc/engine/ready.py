@@ -74,6 +74,10 @@ class ReadyQueue:
             raise ValueError("the task graph has a cycle")
         return order
 
+    def priority(self, name: str) -> float:
+        """The length of the longest chain of work from ``name`` on (its weight included)."""
+        return self._priority[name]
+
     def has_ready(self) -> bool:
         return bool(self._ready)
 

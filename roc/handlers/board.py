@@ -117,7 +117,8 @@ class TaskBoard:
             row.progress = row.progress if percent is None else percent
         elif isinstance(event, TaskFinished):
             row.state = CACHED if event.cached else FINISHED
-            row.duration, row.step, row.progress = (0.0 if event.cached else event.duration), "", None
+            row.duration, row.progress = (0.0 if event.cached else event.duration), None
+            row.step = f"on {event.worker}" if event.worker else ""
         elif isinstance(event, TaskFailed):
             row.state, row.duration, row.reason = FAILED, event.duration, event.reason.strip()
         elif isinstance(event, TaskAborted):

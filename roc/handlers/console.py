@@ -84,6 +84,7 @@ class ConsoleHandler:
         self.finished: list[str] = []
         self.cached: list[str] = []
         self.restored: list[str] = []  # fetched from the remote build cache, not run
+        self.elsewhere: list[str] = []  # run on a cluster worker (and among ``finished``)
         self.failed: list[str] = []
         self.aborted: list[str] = []
         self.skipped: dict[str, str] = {}
@@ -156,7 +157,10 @@ class ConsoleHandler:
             line = f"Restored <<< {name} [from cache, {format_duration(event.duration)}]"
         elif isinstance(event, TaskFinished):
             (self.cached if event.cached else self.finished).append(name)
-            line = f"Finished <<< {name} [{'cached' if event.cached else format_duration(event.duration)}]"
+            where = f" on {event.worker}" if event.worker else ""
+            if event.worker:
+                self.elsewhere.append(name)
+            line = f"Finished <<< {name} [{'cached' if event.cached else format_duration(event.duration)}{where}]"
             if self.finished_note:
                 line += self.finished_note(key)
         elif isinstance(event, TaskFailed):
@@ -173,7 +177,13 @@ class ConsoleHandler:
     def _print_summary(self, event: RunFinished) -> None:
         total = format_duration(time.monotonic() - self.started_at)
         lines = ["", f"Summary: {_count(self.finished + self.restored + self.cached, self.noun)} finished [{total}]"]
-        if self.restored:
+        if self.elsewhere:
+            here = len(self.finished) - len(self.elsewhere)
+            done = "built" if self.kind == "build" else "run"
+            counts = [f"{here} {done} here", f"{len(self.elsewhere)} on the cluster"]
+            counts += [f"{len(self.restored)} restored from the remote cache"] if self.restored else []
+            lines[-1] += f" ({', '.join([*counts, f'{len(self.cached)} up to date'])})"
+        elif self.restored:
             lines[-1] += (f" ({len(self.finished)} built, {len(self.restored)} restored from the remote cache, "
                           f"{len(self.cached)} up to date)")
         if self.cached:

@@ -49,14 +49,19 @@ def new_log_directory(log_base: Path, verb: str = "build") -> Path:
     if not (log_base / "COLCON_IGNORE").exists():
         write_text_atomic(log_base / "COLCON_IGNORE", "")
     for name, target in ((f"latest_{verb}", directory.name), ("latest", f"latest_{verb}")):
-        link = log_base / name
-        if link.exists() and not link.is_symlink():
-            continue  # as colcon: a real file or folder by that name is left alone
-        temporary = log_base / f".{name}.tmp"
-        temporary.unlink(missing_ok=True)
-        temporary.symlink_to(target)
-        os.replace(temporary, link)
+        point_link(log_base / name, target)
     return directory
+
+
+def point_link(link: Path, target: str) -> None:
+    """Make the symbolic link ``link`` point to ``target``, replacing it at once; a real file or folder by
+    that name is left alone (as colcon and the launch library leave it)."""
+    if link.exists() and not link.is_symlink():
+        return
+    temporary = link.with_name(f".{link.name}.tmp")
+    temporary.unlink(missing_ok=True)
+    temporary.symlink_to(target)
+    os.replace(temporary, link)
 
 
 def task_log_folder(event: Event, run_kind: str) -> str:

@@ -66,3 +66,11 @@ def require_launch_library() -> None:
         raise RocError(f"the ROS 2 launch library ({', '.join(missing)}) is not installed for {sys.executable}: "
                        "source your ROS 2 installation (e.g. /opt/ros/jazzy/setup.bash) or install "
                        "ros-<distro>-launch-ros, then run roc launch again")
+
+
+def one_line(message: str) -> str:
+    """The launch library's multi-line errors (``Caught multiple exceptions when trying to load file of format
+    [py]:`` then `` - Error: ...`` per parser) as one line, each cause once."""
+    head, *rest = message.strip().splitlines() or [""]
+    causes = list(dict.fromkeys(line.strip()[2:] for line in rest if line.strip().startswith("- ")))
+    return f"{head.rstrip(':')}: {'; '.join(causes)}" if causes else " ".join(message.split())

@@ -24,6 +24,7 @@ from roc.launch.status import SignalControl, serve
 from roc.launch.warm_start import NOT_USED_SECONDS, start_server, wait_for_server
 
 SETTLE_SECONDS = 1.0  # --check starts once no process has started for this long
+CAUGHT = "Caught exception in launch (see debug for traceback)"  # the launch library's error line
 
 
 @dataclass
@@ -40,10 +41,37 @@ def _runner_command(spec: dict) -> list[str]:
     return [sys.executable, "-m", "roc.launch.runner", json.dumps(spec)]
 
 
-def inspect(launch_file: LaunchFile, mode: str) -> int:
-    """``--print`` or ``--show-args``: the runner prints, nothing is started."""
-    spec = {"mode": mode, "path": str(launch_file.path), "arguments": [], "debug": launch_file.debug}
+def inspect(launch_file: LaunchFile) -> int:
+    """``--print``: the runner prints, nothing is started."""
+    spec = {"mode": "print", "path": str(launch_file.path), "arguments": [], "debug": launch_file.debug}
     return subprocess.run(_runner_command(spec), stdin=subprocess.DEVNULL).returncode
+
+
+def evaluate(launch_file: LaunchFile, mode: str, env: dict[str, str]) -> dict:
+    """``--explain`` or ``--show-args``: what the runner found (roc/launch/introspect.py), nothing started;
+    a RocError with the runner's output when the launch file cannot be evaluated."""
+    import tempfile
+
+    from roc.errors import RocError
+
+    with tempfile.TemporaryFile("w+") as result:
+        spec = {"mode": mode, "path": str(launch_file.path), "arguments": _arguments(launch_file),
+                "debug": launch_file.debug, "result_fd": result.fileno()}
+        done = subprocess.run(_runner_command(spec), stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                              pass_fds=(result.fileno(),), env=env)
+        result.seek(0)
+        text = result.read()
+    if done.returncode != 0 or not text:
+        output = (done.stdout + done.stderr).strip()
+        if CAUGHT in output and not launch_file.debug:  # the library's error, made one line
+            from roc.launch.files import one_line
+
+            raise RocError(f"{launch_file.path}: {one_line(output.split(CAUGHT, 1)[1].removeprefix(': '))}")
+        if launch_file.debug or "\n" in output:
+            print(output, file=sys.stderr)
+            raise RocError(f"{launch_file.path}: the launch failed while evaluated (its output is above)")
+        raise RocError(output.removeprefix("roc: error: ") or f"{launch_file.path}: the launch runner failed")
+    return json.loads(text)
 
 
 def _arguments(launch_file: LaunchFile) -> list[tuple[str, str]]:
@@ -177,3 +205,32 @@ def _relay(stream, running: Running) -> None:
         if not data:
             break
         running.output.write(data.decode(errors="replace"))
+
+
+def argument_text(data: dict) -> str:
+    """``--show-args`` as ros2 launch prints it, plus, for an argument of an included file, the file that
+    declares it and the includes that lead there, and the value an include sets it to; then the includes
+    that cannot be followed without running the launch."""
+    text = "Arguments (pass arguments as '<name>:=<value>'):\n"
+    conditional = False
+    for argument in data["arguments"]:
+        starred = "*" if argument["conditional"] else ""
+        conditional = conditional or argument["conditional"]
+        text += f"\n    '{argument['name']}':{starred}\n        {argument['description']}\n"
+        if argument["default"] is not None:
+            text += f"        (default: {argument['default']})\n"
+        if argument["included_by"]:
+            chain = " < ".join(os.path.basename(file) for file in reversed(argument["included_by"]))
+            text += f"        (declared in {argument['file']}, included by {chain})\n"
+        if argument["set_by"]:
+            value = argument["set_by"]["value"]
+            text += (f"        (set to {value!r} by the include in {os.path.basename(argument['set_by']['file'])}: "
+                     "a value given on the command line does not reach it)\n" if value is not None else
+                     f"        (set by the include in {os.path.basename(argument['set_by']['file'])})\n")
+    if not data["arguments"]:
+        text += "\n  No arguments.\n"
+    elif conditional:
+        text += "\n* argument(s) which are only used if specific conditions occur\n"
+    if data["unknown"]:
+        text += "\nNot known without running the launch:\n" + "".join(f"    {line}\n" for line in data["unknown"])
+    return text

@@ -34,10 +34,18 @@ class ProcessRow:
     started_at: float = 0.0  # time.monotonic() of the last start
     last_line: str = ""
     code: int | None = None
+    host: str = ""  # the SSH destination of a process on another host; "" for this one
+    cpu: float | None = None  # a remote process's usage, as its host reports it (percent of a core)
+    rss: int | None = None  # bytes
 
     @property
     def restarts(self) -> int:
         return max(0, self.starts - 1)
+
+    @property
+    def shown(self) -> str:
+        """Its name in output lines and the live view: ``HOST:NAME`` for a process on another host."""
+        return f"{self.host}:{self.name}" if self.host else self.name
 
 
 @dataclass
@@ -69,17 +77,32 @@ class Monitor:
         """A line of roc's own."""
         self.output.line(text)
 
+    def place(self, name: str, host: str) -> None:
+        """The process runs on another host (shown in its lines and row)."""
+        with self._lock:
+            self._row(name).host = host
+
+    def shown(self, name: str) -> str:
+        row = self.rows.get(name)
+        return row.shown if row else name
+
     def waiting(self, name: str, reason: str) -> None:
         with self._lock:
             row = self._row(name)
             row.state, row.detail = "waiting", reason
         if self.echo:
-            self.output.line(f"[INFO] [{name}]: waiting for {reason}")
+            self.output.line(f"[INFO] [{self.shown(name)}]: waiting for {reason}")
+
+    def usage(self, name: str, cpu: float, rss: int) -> None:
+        """A remote process's CPU and memory, reported by its host."""
+        with self._lock:
+            row = self._row(name)
+            row.cpu, row.rss = cpu, rss
 
     def started(self, name: str, pid: int, command: list[str], warm: bool = False) -> None:
         with self._lock:
             row = self._row(name)
-            row.pid, row.state, row.detail, row.code = pid, "running", "", None
+            row.pid, row.state, row.detail, row.code, row.cpu, row.rss = pid, "running", "", None, None, None
             row.starts += 1
             self.stop_asked.discard(name)
             row.started_at = self.last_start = time.monotonic()
@@ -87,7 +110,7 @@ class Monitor:
                 how = " (warm start)" if warm else ""
                 self.logs.note(name, f"process started with pid [{pid}]{how}: {' '.join(command)}")
         if self.echo:
-            self.output.line(f"[INFO] [{name}]: process started with pid [{pid}]")
+            self.output.line(f"[INFO] [{self.shown(name)}]: process started with pid [{pid}]")
 
     def output_text(self, name: str, text: str) -> None:
         """Output of a process, in pieces as it comes (lines may be split between pieces)."""
@@ -104,7 +127,7 @@ class Monitor:
                 self._row(name).last_line = ROS_STAMP.sub(r"\1", shown[-1], count=1)
         if self.echo:
             for line in complete:
-                self.output.line(f"[{name}] {line}")
+                self.output.line(f"[{self.shown(name)}] {line}")
 
     def exited(self, name: str, pid: int, code: int, command: list[str] | None = None) -> None:
         if self._partial.get(name):  # a last line without its newline
@@ -124,9 +147,9 @@ class Monitor:
                 self.logs.note(name, f"process exited with code {code}")
         if self.echo:
             if code == 0:
-                self.output.line(f"[INFO] [{name}]: process has finished cleanly [pid {pid}]")
+                self.output.line(f"[INFO] [{self.shown(name)}]: process has finished cleanly [pid {pid}]")
             else:
-                self.output.line(f"[ERROR] [{name}]: process has died [pid {pid}, exit code {code}, "
+                self.output.line(f"[ERROR] [{self.shown(name)}]: process has died [pid {pid}, exit code {code}, "
                                  f"cmd '{' '.join(command or [])}'].")
 
     def close(self) -> None:

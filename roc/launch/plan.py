@@ -1,11 +1,10 @@
 """A roc.toml system as engine tasks: one task of kind ``process`` per process, after one ``probe`` task
 per condition it waits for (each probing until the condition holds or the system's timeout), or after
-the task of another process (``process NAME started``). The engine's order is the start-up order, and
-``--explain`` says what each process waits for."""
+the task of another process (``process NAME started``). The engine's order is the start-up order
+(``--explain`` says what each process waits for: roc/launch/explain.py)."""
 
 from __future__ import annotations
 
-import shlex
 import threading
 from collections.abc import Callable
 
@@ -96,19 +95,3 @@ def start_order(tasks: list[Task]) -> list[Task]:
         return depth[key]
 
     return sorted(tasks, key=lambda task: depth_of(task.key))
-
-
-def explain(system: System, tasks: list[Task], command: Callable[[ProcessSpec], list[str]]) -> list[str]:
-    """What each process waits for, in start-up order, with the command it runs."""
-    specs = {spec.label: spec for spec in system.processes}
-    lines = [f"[launch.{system.name}] of {system.path}: {len(specs)} processes; conditions wait up to "
-             f"{system.timeout:g} s"]
-    for task in start_order(tasks):
-        if task.kind != PROCESS:
-            continue
-        spec = specs[task.name]
-        waits = [condition.text for condition in spec.after]
-        lines.append(f"{spec.label}: {'starts after: ' + ', '.join(waits) if waits else 'starts at once'}"
-                     f"{' (respawns)' if spec.respawn else ''}")
-        lines.append(f"    {shlex.join(command(spec))}")
-    return lines

@@ -94,29 +94,30 @@ def describe(spec: dict[str, Any]) -> int:
     return 0
 
 
-def show_arguments(spec: dict[str, Any]) -> int:
-    """``--show-args``: the launch arguments the file declares, in ros2 launch's words."""
-    from launch.launch_description_sources import get_launch_description_from_any_launch_file
+def _result(spec: dict[str, Any], data: dict[str, Any]) -> None:
+    """``--explain`` and ``--show-args`` answer roc as JSON on the file descriptor ``result_fd``."""
+    with os.fdopen(spec["result_fd"], "w") as stream:
+        json.dump(data, stream)
 
-    description = get_launch_description_from_any_launch_file(spec["path"])
-    print("Arguments (pass arguments as '<name>:=<value>'):")
-    arguments = description.get_launch_arguments()
-    conditional = False
-    for argument in arguments:
-        starred = "*" if argument._conditionally_included else ""
-        conditional = conditional or bool(starred)
-        text = f"\n    '{argument.name}':{starred}\n        {argument.description}"
-        if argument.default_value is not None:
-            text += f"\n        (default: {' + '.join(token.describe() for token in argument.default_value)})"
-        print(text)
-    if not arguments:
-        print("\n  No arguments.")
-    elif conditional:
-        print("\n* argument(s) which are only used if specific conditions occur")
+
+def explain(spec: dict[str, Any]) -> int:
+    """``--explain``: what the launch would start, nothing started (roc/launch/introspect.py)."""
+    from roc.launch.introspect import explain as evaluate
+
+    code, data = evaluate(spec["path"], [tuple(pair) for pair in spec["arguments"]], spec.get("debug", False))
+    _result(spec, data)
+    return code
+
+
+def show_arguments(spec: dict[str, Any]) -> int:
+    """``--show-args``: the arguments of the file and of the files it includes (roc/launch/introspect.py)."""
+    from roc.launch.introspect import arguments
+
+    _result(spec, arguments(spec["path"], [tuple(pair) for pair in spec["arguments"]]))
     return 0
 
 
-MODES = {"launch": launch, "print": describe, "show-args": show_arguments}
+MODES = {"launch": launch, "print": describe, "show-args": show_arguments, "explain": explain}
 
 
 def main(argv: list[str]) -> int:

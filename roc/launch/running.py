@@ -29,6 +29,7 @@ class RunOptions:
     view: bool  # the live status view (a terminal)
     check: CheckOptions | None = None
     warm_start: bool = True  # fork Python processes from a warm interpreter (roc/launch/warm_start.py)
+    ros_log_layout: bool = False  # a run directory in log_base named as ros2 launch's (outside a workspace)
 
 
 class Running:
@@ -40,7 +41,11 @@ class Running:
 
             self.check_file = load(options.check.path)  # a bad file is reported before anything starts
         self.log_directory: Path | None = None
-        if options.log_base is not None:
+        if options.log_base is not None and options.ros_log_layout:
+            from roc.launch.logs import new_ros_run_directory
+
+            self.log_directory = new_ros_run_directory(options.log_base.absolute())
+        elif options.log_base is not None:
             from roc.handlers.logs import new_log_directory
 
             self.log_directory = new_log_directory(options.log_base.absolute(), "launch")

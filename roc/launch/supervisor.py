@@ -14,10 +14,11 @@ from collections.abc import Callable
 
 from roc.engine.process import TaskError
 from roc.launch.monitor import Monitor
-from roc.launch.system import ProcessSpec
+from roc.launch.remote import RemoteProcess
+from roc.launch.system import HostSpec, ProcessSpec
 from roc.launch.warm_start import ForkedProcess, WarmStart
 
-Process = subprocess.Popen | ForkedProcess
+Process = subprocess.Popen | ForkedProcess | RemoteProcess
 
 SIGTERM_AFTER = 5.0
 SIGKILL_AFTER = 5.0
@@ -30,6 +31,12 @@ def command(spec: ProcessSpec) -> list[str]:
     return [str(find_executable(spec.package, spec.executable)), *spec.arguments, *spec.ros_arguments()]
 
 
+def _command_line(process: Process) -> list[str]:
+    """The command line a process runs (on its host)."""
+    args = process.args
+    return [str(word) for word in args] if isinstance(args, list | tuple) else [str(args)]
+
+
 class Supervisor:
     def __init__(self, monitor: Monitor, environment: Callable[[dict[str, str]], dict[str, str]],
                  record: Callable[[int], None]):
@@ -37,6 +44,9 @@ class Supervisor:
         self.warm: WarmStart | None = None  # the run's fork servers, if it forks its Python processes
         self.environment = environment  # a process's extra variables -> its whole environment
         self.record = record  # tells the orphan guard about each process started
+        self.hosts: dict[str, HostSpec] = {}  # where the processes with a host run (roc/launch/remote.py)
+        self.token = ""  # the run's token (the orphan guard's), made unique per remote process start
+        self._remote_starts = 0
         self.stopping = monitor.stopping  # set: no more restarts, and exits are no failures
         self.failed: list[str] = []  # processes that ended with an error (and are not restarted)
         self._lock = threading.Lock()
@@ -46,46 +56,61 @@ class Supervisor:
 
     def start(self, spec: ProcessSpec) -> None:
         """Start the process (raises TaskError when it cannot); a thread watches it from then on."""
-        line = command(spec)
-        process = self._spawn(spec, line)
-        watcher = threading.Thread(target=self._watch, args=(spec, line, process), name=f"roc-{spec.label}",
-                                   daemon=True)
+        process = self._spawn(spec)
+        watcher = threading.Thread(target=self._watch, args=(spec, process), name=f"roc-{spec.label}", daemon=True)
         with self._lock:
             self._watchers.append(watcher)
         watcher.start()
 
-    def _spawn(self, spec: ProcessSpec, command: list[str]) -> Process:
-        env = self.environment(spec.env)
-        process: Process | None = None
-        if self.warm is not None and spec.warm_start:
-            process = self.warm.popen(command, env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                      stderr=subprocess.STDOUT)
-        if process is None:
-            try:
-                process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                           stderr=subprocess.STDOUT, process_group=0, env=env)
-            except OSError as error:
-                raise TaskError(f"cannot run '{command[0]}': {error.strerror}") from None
-        self.record(process.pid)
+    def _spawn(self, spec: ProcessSpec) -> Process:
+        process = self._spawn_remote(spec) if spec.host else self._spawn_local(spec)
         with self._lock:
             self._running[spec.label] = process
             self._changed.notify_all()
-        self.monitor.started(spec.label, process.pid, command, warm=isinstance(process, ForkedProcess))
+        self.monitor.started(spec.label, process.pid, _command_line(process), warm=isinstance(process, ForkedProcess))
         return process
 
-    def _watch(self, spec: ProcessSpec, command: list[str], process: Process) -> None:
+    def _spawn_local(self, spec: ProcessSpec) -> Process:
+        line = command(spec)
+        env = self.environment(spec.env)
+        process: Process | None = None
+        if self.warm is not None and spec.warm_start:
+            process = self.warm.popen(line, env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                      stderr=subprocess.STDOUT)
+        if process is None:
+            try:
+                process = subprocess.Popen(line, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                           stderr=subprocess.STDOUT, process_group=0, env=env)
+            except OSError as error:
+                raise TaskError(f"cannot run '{line[0]}': {error.strerror}") from None
+        self.record(process.pid)
+        return process
+
+    def _spawn_remote(self, spec: ProcessSpec) -> RemoteProcess:
+        label = f"{spec.host}:{spec.label}"
+        self._remote_starts += 1  # a token per start: the guard of a lost session must not stop its successor
+        token = f"{self.token}@{spec.host}/{spec.label}/{self._remote_starts}"
+        process = RemoteProcess(self.hosts[spec.host], spec, token,
+                                self.environment({}),
+                                note=lambda text: self.monitor.note(f"[WARNING] [{label}]: {text}"),
+                                usage=lambda cpu, rss: self.monitor.usage(spec.label, cpu, rss))
+        self.record(process.ssh.pid)  # the orphan guard ends the session, and the guard there the process
+        process.wait_started()
+        return process
+
+    def _watch(self, spec: ProcessSpec, process: Process) -> None:
         while True:
             assert process.stdout is not None
             while data := os.read(process.stdout.fileno(), 65536):
                 self.monitor.output_text(spec.label, data.decode(errors="replace"))
             process.stdout.close()
             code = process.wait()
-            self.monitor.exited(spec.label, process.pid, code, command)
+            self.monitor.exited(spec.label, process.pid, code, _command_line(process))
             asked = spec.label in self.monitor.stop_asked  # stopped on request: no respawn, no failure
             if not spec.respawn or asked or self.stopping.is_set() or self.stopping.wait(spec.respawn_delay):
                 break
             try:
-                process = self._spawn(spec, command)
+                process = self._spawn(spec)
             except TaskError as error:
                 self.monitor.note(f"[ERROR] [{spec.label}]: {error}")
                 break
@@ -121,9 +146,13 @@ class Supervisor:
                               (signal.SIGKILL, SIGKILL_AFTER)):
             if process.poll() is not None:
                 return
-            self.monitor.note(f"[INFO] [{label}]: sending signal '{signal.Signals(signum).name}' to process[{label}]")
+            shown = self.monitor.shown(label)
+            self.monitor.note(f"[INFO] [{shown}]: sending signal '{signal.Signals(signum).name}' to process[{shown}]")
             try:
-                os.killpg(process.pid, signum)  # the process leads its own group: its children too
+                if isinstance(process, RemoteProcess):
+                    process.send_signal(signum)  # to its group on its host
+                else:
+                    os.killpg(process.pid, signum)  # the process leads its own group: its children too
             except ProcessLookupError:
                 return
             try:

@@ -16,6 +16,10 @@ supervisor (no launch library needed).
     respawn = false
     respawn-delay = 1.0             # seconds (default 1)
     warm-start = true               # a Python node forked from a warm interpreter (roc/launch/warm_start.py)
+    host = "user@robot"             # run it on another host, over SSH (roc/launch/remote.py)
+
+    [launch.nav.hosts."user@robot"]
+    setup = ["/opt/ros/jazzy/setup.bash", "/home/user/ws/install/setup.bash"]   # sourced there first
 
     [[launch.nav.process]]
     package = "nav2_amcl"
@@ -52,8 +56,10 @@ PROCESS_KEYS: dict[str, tuple[tuple[type, ...], bool]] = {
     "namespace": (STRINGS, False), "parameters": ((dict,), False), "remappings": ((dict,), False),
     "arguments": ((list,), False), "env": ((dict,), False), "respawn": ((bool,), False),
     "respawn-delay": (NUMBER, False), "after": ((list,), False), "warm-start": ((bool,), False),
+    "host": (STRINGS, False),
 }
-SYSTEM_KEYS = {"timeout": NUMBER, "process": (list, dict)}
+SYSTEM_KEYS = {"timeout": NUMBER, "process": (list, dict), "hosts": (dict,)}
+HOST_KEYS: dict[str, tuple[tuple[type, ...], bool]] = {"setup": ((str, list), False)}
 # kind -> the words that may follow its name (the empty tail: the short form)
 CONDITION_TAILS = {"node": ("", "exists"), "service": ("", "is available", "exists"),
                    "action": ("", "is available", "exists"), "topic": ("", "exists", "publishes"),
@@ -86,6 +92,7 @@ class ProcessSpec:
     respawn_delay: float = 1.0
     after: list[Condition] = field(default_factory=list)
     warm_start: bool = True
+    host: str = ""  # an OpenSSH destination to run it on; "" runs it here
     where: str = ""  # file:line
 
     def ros_arguments(self) -> list[str]:
@@ -103,11 +110,24 @@ class ProcessSpec:
 
 
 @dataclass
+class HostSpec:
+    """``[launch.NAME.hosts."DEST"]``: what to source on host DEST before its processes start."""
+
+    destination: str  # as ssh takes it: user@robot, an address, an alias of ~/.ssh/config
+    setup: list[str] = field(default_factory=list)
+    where: str = ""  # file:line
+
+
+@dataclass
 class System:
     name: str
     path: Path
     processes: list[ProcessSpec]
     timeout: float = DEFAULT_TIMEOUT
+    hosts: dict[str, HostSpec] = field(default_factory=dict)  # every host a process names
+
+    def remote(self) -> list[ProcessSpec]:
+        return [spec for spec in self.processes if spec.host]
 
 
 def find_roc_toml(start: Path) -> Path | None:
@@ -150,8 +170,9 @@ def load_system(path: Path, name: str) -> System:
             raise ConfigError(path, key, f"unknown key of [launch.{name}]; {hint + ' ' if hint else ''}use timeout "
                               f"and [[launch.{name}.process]] tables", line)
         if not isinstance(value, SYSTEM_KEYS[key]) or isinstance(value, bool):
-            raise ConfigError(path, key, f"expected {'a number' if key == 'timeout' else 'process tables'}, "
-                              f"got {value!r}", line)
+            expected = {"timeout": "a number", "process": "process tables",
+                        "hosts": 'tables [launch.NAME.hosts."DEST"]'}
+            raise ConfigError(path, key, f"expected {expected[key]}, got {value!r}", line)
     entries = table.get("process", [])
     entries = [entries] if isinstance(entries, dict) else entries
     if not entries:
@@ -161,7 +182,30 @@ def load_system(path: Path, name: str) -> System:
                  for i, entry in enumerate(entries)]
     _check_names(path, processes)
     timeout = float(table.get("timeout", DEFAULT_TIMEOUT))
-    return System(name, path, processes, timeout)
+    hosts = _hosts(path, text, name, table.get("hosts", {}), header)
+    for spec in processes:
+        if spec.host and spec.host not in hosts:
+            hosts[spec.host] = HostSpec(spec.host, [], spec.where)
+    return System(name, path, processes, timeout, hosts)
+
+
+def _hosts(path: Path, text: str, system: str, table: dict[str, Any], header: int) -> dict[str, HostSpec]:
+    """``[launch.NAME.hosts."DEST"]`` tables: ``setup``, a file or a list of files."""
+    hosts = {}
+    for destination, entry in table.items():
+        start = (header_lines(text, f"launch.{system}.hosts.{destination}")
+                 or header_lines(text, f"launch.{system}.hosts") or [header])[0]
+        where = f'[launch.{system}.hosts."{destination}"]'
+        if not isinstance(entry, dict):
+            raise ConfigError(path, destination, f"expected a table {where} with setup = [...]", start)
+        check_table(path, text, start, entry, HOST_KEYS, where)
+        setup = entry.get("setup", [])
+        setup = [setup] if isinstance(setup, str) else setup
+        if not all(isinstance(item, str) and item for item in setup):
+            raise ConfigError(path, "setup", "expected a file or a list of files to source",
+                              key_line(text, start, "setup"))
+        hosts[destination] = HostSpec(destination, setup, f"{path}:{start}")
+    return hosts
 
 
 def _flatten(table: dict[str, Any], prefix: str = "") -> dict[str, Any]:
@@ -185,6 +229,10 @@ def _process(path: Path, text: str, entry: Any, start: int, system: str) -> Proc
     for key in ("arguments", "after"):
         if not all(isinstance(v, str) for v in entry.get(key, [])):
             raise ConfigError(path, key, "expected a list of strings", key_line(text, start, key))
+    host = entry.get("host", "")
+    if "host" in entry and (not host or host.startswith("-") or any(c.isspace() for c in host)):
+        raise ConfigError(path, "host", f"{host!r} is not an SSH destination (user@robot, an address, an alias of "
+                          "~/.ssh/config)", key_line(text, start, "host"))
     name, namespace = entry.get("name", ""), entry.get("namespace", "")
     if namespace and not namespace.startswith("/"):
         namespace = f"/{namespace}"
@@ -193,7 +241,7 @@ def _process(path: Path, text: str, entry: Any, start: int, system: str) -> Proc
                        _flatten(entry.get("parameters", {})), dict(entry.get("remappings", {})),
                        list(entry.get("arguments", [])), dict(entry.get("env", {})), entry.get("respawn", False),
                        float(entry.get("respawn-delay", 1.0)), warm_start=entry.get("warm-start", True),
-                       where=f"{path}:{start}")
+                       host=entry.get("host", ""), where=f"{path}:{start}")
     line = key_line(text, start, "after")
     spec.after = [parse_condition(condition, path, line) for condition in entry.get("after", [])]
     return spec

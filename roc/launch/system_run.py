@@ -43,7 +43,7 @@ def _warm_start(system: System, running: Running) -> WarmStart:
     starts = []
     for spec in system.processes:
         try:
-            if spec.warm_start:
+            if spec.warm_start and not spec.host:
                 starts.append((command(spec), running.environment(spec.env), spec.respawn))
         except RocError:
             continue  # reported when the process is due to start
@@ -59,6 +59,9 @@ def launch_system(system: System, options: RunOptions, use_daemon: bool, spin_ti
 
     running = Running(options, echo=True)
     supervisor = Supervisor(running.monitor, running.environment, running.guard.record)
+    supervisor.hosts, supervisor.token = system.hosts, running.guard.token
+    for spec in system.remote():
+        running.monitor.place(spec.label, spec.host)
     session = LazySession(use_daemon, spin_time)
     status = serve(running, SupervisorControl(supervisor, system))  # roc tui's view of the run
     settled = threading.Event()

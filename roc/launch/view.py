@@ -154,9 +154,13 @@ class LiveView:
         now = time.monotonic()
         for row in self.rows():
             running = row.state == "running"
-            cpu, memory = self.usage(row.pid) if running else ("", "")
+            cpu, memory = ("", "")
+            if running and row.host:  # its host reports it; a local PID of that number is another process
+                cpu, memory = (f"{row.cpu:.0f}%", _memory(row.rss or 0)) if row.cpu is not None else ("", "")
+            elif running:
+                cpu, memory = self.usage(row.pid)
             state = row.state + (f" ({row.detail})" if row.detail else "")
-            cells = (row.name, str(row.pid or ""), state, str(row.restarts), cpu, memory,
+            cells = (row.shown, str(row.pid or ""), state, str(row.restarts), cpu, memory,
                      _duration(now - row.started_at) if running else "", row.last_line)
             table.add_row(*(Text(cell, style=STATE_STYLES.get(row.state, "") if index == 2 else "")
                             for index, cell in enumerate(cells)))

@@ -66,6 +66,13 @@ def underlay_content(name: str, prefixes: tuple[str, ...]) -> str | None:
     return f"{prefix}:package.xml:{file_sha256(Path(manifest))}"
 
 
+def portable_toolchain(toolchain: dict[str, object], path: str | None) -> dict[str, object]:
+    """Toolchain parts (roc.builder.fingerprint.toolchain_parts) with each tool by content, not by path
+    and time stamp."""
+    return {part: tool_content(part.removeprefix("tool "), path) if part.startswith("tool ") else value
+            for part, value in toolchain.items()}
+
+
 def platform_parts() -> dict[str, object]:
     return {"system": sys.platform, "machine": platform.machine(), "libc": list(platform.libc_ver())}
 
@@ -81,27 +88,30 @@ class RemoteKeys:
         self.build_base = build_base
         self.keys: dict[str, str | None] = {}
 
-    def _dependency_key(self, name: str) -> str | None:
+    def dependency_key(self, name: str) -> str | None:
+        """The remote key of a package computed in this run, else the one its last build recorded."""
         if name in self.keys:
             return self.keys[name]
         return read_state(self.build_base / name).get("remote_key")
 
     def key(self, name: str, parts: dict) -> str | None:
-        dependencies = {dependency: self._dependency_key(dependency) for dependency in parts["dependencies"]}
-        if None in dependencies.values():
-            self.keys[name] = None
-            return None
-        toolchain = {part: tool_content(part.removeprefix("tool "), self.path) if part.startswith("tool ") else value
-                     for part, value in parts["toolchain"].items()}
-        portable = {**parts, "dependencies": dependencies, "toolchain": toolchain,
-                    "underlay": {n: underlay_content(n, self.prefixes) for n in parts["underlay"]},
-                    "platform": platform_parts(), "format": FORMAT}
-        self.keys[name] = combine(portable)
+        portable = self.portable_parts(parts)
+        self.keys[name] = None if portable is None else combine(portable)
         return self.keys[name]
+
+    def portable_parts(self, parts: dict) -> dict | None:
+        """What the key of a package with these fingerprint parts is made of (None: a dependency has
+        no key)."""
+        dependencies = {dependency: self.dependency_key(dependency) for dependency in parts["dependencies"]}
+        if None in dependencies.values():
+            return None
+        return {**parts, "dependencies": dependencies, "toolchain": portable_toolchain(parts["toolchain"], self.path),
+                "underlay": {n: underlay_content(n, self.prefixes) for n in parts["underlay"]},
+                "platform": platform_parts(), "format": FORMAT}
 
     def missing_dependency(self, parts: dict) -> str | None:
         """The first dependency without a remote key (why a package has none)."""
-        return next((d for d in parts["dependencies"] if self._dependency_key(d) is None), None)
+        return next((d for d in parts["dependencies"] if self.dependency_key(d) is None), None)
 
 
 def placed_key(key: str, places: Places) -> str:

@@ -29,6 +29,7 @@ from rclpy.qos import (
 from rclpy.serialization import deserialize_message
 
 from roc.errors import RocError
+from roc.ros.content_filter import ContentFilter
 from roc.ros.messages import value_to_data
 from roc.ros.protocol import HEARTBEAT_SECONDS, Events, full_name
 from roc.ros.raw_subscription import Receiver, gid_text
@@ -111,6 +112,32 @@ def _topic_class(graph, topic: str, params: dict[str, Any], wait_for_type: bool)
     return cls, type_name, found
 
 
+def content_filter(params: dict[str, Any], cls) -> ContentFilter | None:
+    """The ``content_filter`` of stream ``params`` ({expression, parameters, middleware}), checked
+    against the topic's message class (a ContentFilterError names what is wrong)."""
+    given = params.get("content_filter")
+    if not given:
+        return None
+    found = ContentFilter(given["expression"], given.get("parameters") or [])
+    found.check(cls)
+    return found
+
+
+def subscribe_filtered(receiver: Receiver, topic: str, cls, qos: QoSProfile, found: ContentFilter | None,
+                       middleware: bool = True) -> dict[str, Any]:
+    """Subscribe ``receiver`` to ``topic``; with a content filter, the middleware filters where it can
+    (``middleware``: may it; the user may ask roc to). Returns the ``content_filter`` of the
+    ``subscribed`` event: {by: "middleware" | "roc", reason} (empty without a filter)."""
+    if found is None:
+        receiver.subscribe(topic, cls, topic, qos)
+        return {}
+    if not middleware:
+        receiver.subscribe(topic, cls, topic, qos)
+        return {"by": "roc", "reason": "asked to filter in roc (ROC_MIDDLEWARE_CONTENT_FILTER=0)"}
+    unfiltered = receiver.subscribe(topic, cls, topic, qos, (found.expression, found.parameters))
+    return {"by": "roc", "reason": unfiltered} if unfiltered else {"by": "middleware", "reason": None}
+
+
 def echo(graph, params: dict[str, Any]) -> Events:
     """Subscribe to ``params["topic"]`` and yield ``{"event": "messages", "messages": [{data, info,
     lost}]}`` with what arrived since the last event (``lost``: messages the publisher's sequence
@@ -119,20 +146,28 @@ def echo(graph, params: dict[str, Any]) -> Events:
     graph's), ``qos`` (see qos_profile), ``timeout`` (seconds for the first message, counted from the
     start, the wait for a publisher included; then ``{"event": "timeout"}`` ends the stream),
     ``latest_value`` (the last message of each event also as plain data, ``value``, its strings and
-    arrays cut after ``truncate_length`` elements: for a client that loads no rclpy)."""
+    arrays cut after ``truncate_length`` elements: for a client that loads no rclpy), ``content_filter``
+    (``{expression, parameters, middleware}``: only the messages that pass, filtered by the middleware
+    where it can, else here; ``subscribed`` then says which, and no message counts as lost, since the
+    ones filtered out leave gaps in the sequence numbers)."""
     topic, timeout = params["topic"], params.get("timeout")
     started = time.monotonic()
     if timeout is not None:
         params = {**params, "wait": min(params.get("wait", 0.0), timeout)}
     cls, type_name, found = yield from _topic_class(graph, topic, params, wait_for_type=False)
+    wanted = content_filter(params, cls)
     receiver = Receiver(graph.node)
     try:
-        receiver.subscribe(topic, cls, topic, subscription_profile(params.get("qos", {}), found))
-        yield {"event": "subscribed", "type": type_name}
+        filtering = subscribe_filtered(receiver, topic, cls, subscription_profile(params.get("qos", {}), found),
+                                       wanted, (params.get("content_filter") or {}).get("middleware", True))
+        local = wanted if filtering.get("by") == "roc" else None
+        yield {"event": "subscribed", "type": type_name, **({"content_filter": filtering} if filtering else {})}
         last_sequence: dict[str, int] = {}  # by publisher gid
         deadline = started + timeout if timeout is not None else None
         while True:
             batch = receiver.batch(HEARTBEAT_SECONDS, MAX_BATCH)
+            if local is not None:
+                batch = [item for item in batch if local.accepts(deserialize_message(item[1], cls))]
             if not batch:
                 if deadline is not None and time.monotonic() >= deadline:
                     yield {"event": "timeout"}
@@ -143,6 +178,8 @@ def echo(graph, params: dict[str, Any]) -> Events:
             messages = []
             for _, data, info in batch:
                 sequence, gid = info["publication_sequence_number"], info.pop("gid")
+                if wanted is not None:
+                    sequence = None  # the messages filtered out are not lost
                 previous = last_sequence.get(gid)
                 lost = sequence - previous - 1 if sequence is not None and previous is not None else 0
                 if sequence is not None:
@@ -234,19 +271,28 @@ def stats(graph, params: dict[str, Any]) -> Events:
     qos = {**(params.get("qos") or {}), "durability": (params.get("qos") or {}).get("durability") or "volatile"}
     columns = ("sequence", "source", "received", "size", "stamp")
     receiver = Receiver(graph.node)
+    local: dict[Hashable, tuple[ContentFilter, Any]] = {}  # filtered here, with the topic's class
     try:
         for topic in params["topics"]:
             cls, type_name, found = yield from _topic_class(graph, topic, params, wait_for_type=True)
-            receiver.subscribe(topic, cls, topic, subscription_profile(qos, found))
-            yield {"event": "subscribed", "topic": topic, "type": type_name}
+            wanted = content_filter(params, cls)
+            filtering = subscribe_filtered(receiver, topic, cls, subscription_profile(qos, found), wanted,
+                                           (params.get("content_filter") or {}).get("middleware", True))
+            if wanted is not None and filtering["by"] == "roc":
+                local[topic] = (wanted, cls)
+            yield {"event": "subscribed", "topic": topic, "type": type_name,
+                   **({"content_filter": filtering} if filtering else {})}
+        filtered = bool(params.get("content_filter"))  # sequence numbers have gaps: the rate is of what came
         while True:
             arrived: dict[Hashable, dict[str, list]] = {topic: {column: [] for column in columns}
                                                         for topic in params["topics"]}
             due = time.monotonic() + period
             while (remaining := due - time.monotonic()) > 0:
                 for topic, data, info in receiver.batch(remaining):
+                    if topic in local and not local[topic][0].accepts(deserialize_message(data, local[topic][1])):
+                        continue
                     columns_of_topic = arrived[topic]
-                    columns_of_topic["sequence"].append(info["publication_sequence_number"])
+                    columns_of_topic["sequence"].append(None if filtered else info["publication_sequence_number"])
                     columns_of_topic["source"].append(info["source_timestamp"])
                     columns_of_topic["received"].append(info["received_timestamp"])
                     columns_of_topic["size"].append(len(data))

@@ -11,7 +11,7 @@ Two facts make the local part exact:
 
 Participants on other hosts (a discovery range beyond this host) cannot be counted: the caller waits
 for the graph to go quiet for them. This module reads /proc and rclpy endpoint infos; it never
-imports rclpy itself.
+imports rclpy itself (``roc tui`` finds each node's process with it too).
 """
 
 from __future__ import annotations
@@ -30,10 +30,17 @@ FAST_DDS_VENDOR = b"\x01\x0f"
 UDP_TABLES = (Path("/proc/net/udp"), Path("/proc/net/udp6"))
 
 
-def metatraffic_ports(domain_id: int) -> set[int]:
-    """The metatraffic unicast ports of every possible participant of ``domain_id``."""
-    first = PORT_BASE + DOMAIN_GAIN * domain_id + METATRAFFIC_UNICAST_OFFSET
-    return {first + PARTICIPANT_GAIN * participant for participant in range(MAX_PARTICIPANT_ID + 1)}
+def is_metatraffic_port(port: int, domain_id: int) -> bool:
+    """A metatraffic unicast port of a participant of ``domain_id``."""
+    offset = port - PORT_BASE - DOMAIN_GAIN * domain_id - METATRAFFIC_UNICAST_OFFSET
+    return 0 <= offset <= PARTICIPANT_GAIN * MAX_PARTICIPANT_ID and offset % PARTICIPANT_GAIN == 0
+
+
+def process_bits(prefix: bytes) -> int | None:
+    """The 16 low bits of the process id in a Fast DDS GUID prefix (None for another vendor's)."""
+    if prefix[:2] != FAST_DDS_VENDOR or len(prefix) < 6:
+        return None
+    return int.from_bytes(prefix[4:6], "little")
 
 
 def own_socket_inodes() -> set[str]:
@@ -52,7 +59,6 @@ def own_socket_inodes() -> set[str]:
 def local_participant_count(domain_id: int, tables: tuple[Path, ...] = UDP_TABLES) -> int | None:
     """How many participants of other processes on this host (this network namespace) are in
     ``domain_id``; None when the UDP tables cannot be read (not Linux)."""
-    wanted = metatraffic_ports(domain_id)
     own = own_socket_inodes()
     bound: set[int] = set()
     try:
@@ -60,7 +66,7 @@ def local_participant_count(domain_id: int, tables: tuple[Path, ...] = UDP_TABLE
             for line in table.read_text().splitlines()[1:]:
                 fields = line.split()
                 port = int(fields[1].rsplit(":", 1)[1], 16)
-                if port in wanted and fields[9] not in own:
+                if is_metatraffic_port(port, domain_id) and fields[9] not in own:
                     bound.add(port)
     except (OSError, IndexError, ValueError):
         return None
@@ -72,9 +78,8 @@ def discovered_local_peers(writers: list[Any], pid: int) -> int | None:
     infos of the ``ros_discovery_info`` writers); None when this process's own writer is not among
     them yet or the middleware is not Fast DDS (its GUID layout is unknown)."""
     prefixes = {bytes(info.endpoint_gid)[:12] for info in writers}
-    own_pid = (pid & 0xFFFF).to_bytes(2, "little")
-    own = {p for p in prefixes if p[:2] == FAST_DDS_VENDOR and p[4:6] == own_pid}
+    own = {p for p in prefixes if process_bits(p) == pid & 0xFFFF}
     if not own:
         return None
     host = next(iter(own))[2:4]
-    return sum(1 for p in prefixes - own if p[:2] == FAST_DDS_VENDOR and p[2:4] == host)
+    return sum(1 for p in prefixes - own if process_bits(p) is not None and p[2:4] == host)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 import threading
 import time
-from collections.abc import Mapping, MutableMapping
+from collections.abc import Mapping, MutableMapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -25,6 +25,7 @@ from rclpy.node import Node, NodeNameNonExistentError
 from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 
+from roc import distribution
 from roc.errors import RocError
 from roc.ros.discovery import DISCOVERY_TOPIC, discovered_local_peers, local_participant_count
 from roc.ros.params import WRITES, parameter_value
@@ -100,15 +101,21 @@ def _names_and_types(pairs) -> list[dict[str, Any]]:
     return [{"name": name, "types": list(types)} for name, types in sorted(pairs)]
 
 
-PROFILE_VARIABLES = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE")  # Fast DDS 2 (Jazzy), 3
-PARTICIPANT_PROFILE = Path(__file__).with_name("fastdds_participant.xml")
-BRIDGE_PROFILE = Path(__file__).with_name("fastdds_bridge.xml")
+PROFILE_VARIABLES = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE")  # Fast DDS 2's; 3's
+# roc's Fast DDS profiles by Fast DDS major version: 3 (Kilted on) renamed elements of 2's (Jazzy) and
+# rejects a whole file that has one of 2's names (fastdds3_participant.xml), and 2 does the same
+_HERE = Path(__file__).parent
+PROFILES = {2: (_HERE / "fastdds_participant.xml", _HERE / "fastdds_bridge.xml"),
+            3: (_HERE / "fastdds3_participant.xml", _HERE / "fastdds3_bridge.xml")}
+# this environment's (roc.distribution): every roc participant's, and a bridge's
+PARTICIPANT_PROFILE, BRIDGE_PROFILE = PROFILES[distribution.current().fastdds_major]
+OWN_PROFILES = {str(path) for pair in PROFILES.values() for path in pair}
 
 
 def users_profile(environment: Mapping[str, str] = os.environ) -> str | None:
     """The Fast DDS profile file the user chose, if any (roc's own do not count)."""
-    ours = {str(PARTICIPANT_PROFILE), str(BRIDGE_PROFILE)}
-    return next((environment[v] for v in PROFILE_VARIABLES if environment.get(v) and environment[v] not in ours), None)
+    return next((environment[v] for v in PROFILE_VARIABLES
+                 if environment.get(v) and environment[v] not in OWN_PROFILES), None)
 
 
 def middleware(environment: Mapping[str, str] = os.environ) -> str:
@@ -118,10 +125,12 @@ def middleware(environment: Mapping[str, str] = os.environ) -> str:
 
 def use_profile(profile: Path, environment: MutableMapping[str, str] = os.environ) -> None:
     """Have Fast DDS load ``profile`` for this process's participants (it reads the file once, at the
-    first), unless the user chose one or the middleware is not Fast DDS."""
+    first), unless the user chose one or the middleware is not Fast DDS. Only through the variable this
+    distribution's Fast DDS reads first: Kilted's rmw warns on stderr that the other one is deprecated."""
     if middleware(environment).startswith("rmw_fastrtps") and users_profile(environment) is None:
-        for variable in PROFILE_VARIABLES:
-            environment[variable] = str(profile)
+        for variable in PROFILE_VARIABLES:  # roc's own, inherited from the roc process that started this one
+            environment.pop(variable, None)
+        environment[distribution.current().profiles_variable] = str(profile)
 
 
 class Graph:
@@ -131,18 +140,22 @@ class Graph:
     BRIDGE_PROFILE for a bridge's. Both announce the participant every 0.5 s."""
 
     def __init__(self, node_name: str | None = None, domain_id: int | None = None, events: bool = False,
-                 profile: Path = PARTICIPANT_PROFILE) -> None:
+                 profile: Path = PARTICIPANT_PROFILE, arguments: Sequence[str] = ()) -> None:
         """``events``: spin with rclpy's C++ EventsExecutor, which takes a message in a fraction of the
         Python executor's time (at 5 kHz: no loss and 0.2 ms instead of 10 % loss and 60 ms here). In
         rclpy 7.1.6 it never calls a callback that takes message info, so echo and hz take their
-        messages with roc.ros.raw_subscription instead."""
+        messages with roc.ros.raw_subscription instead.
+
+        ``arguments``: the node's ROS arguments (``--ros-args --remap OLD:=NEW``, as rosbag2 gives its
+        player's). rcl never reads roc's own command line, where it would take any ``NAME:=VALUE`` word
+        for a remapping rule (and warn that this syntax is deprecated)."""
         use_profile(profile)
         self.context = Context()
-        rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO, domain_id=domain_id)
+        rclpy.init(args=[], context=self.context, signal_handler_options=SignalHandlerOptions.NO, domain_id=domain_id)
         # roc's own node shows as little as it can, to other tools too: no parameter, type description
         # or /rosout endpoints, and no /parameter_events publisher (its parameters never change)
         self.node = Node(node_name or own_node_name(os.getpid()), context=self.context, start_parameter_services=False,
-                         enable_rosout=False,
+                         enable_rosout=False, cli_args=list(arguments),
                          parameter_overrides=[Parameter("start_type_description_service", value=False)])
         for publisher in list(self.node.publishers):
             if publisher.topic_name == "/parameter_events":

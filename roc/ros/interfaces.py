@@ -114,13 +114,21 @@ def installed_definition(type_name: str) -> str:
     return definition_path(type_name).read_text()
 
 
+# An interface defined in IDL only, as Kilted's keyed types are (test_msgs/msg/KeyedString: '@key string key;'):
+# no .msg file to read line by line, and its nested types named by #include lines
+IDL_MODULE = re.compile(r"^\s*module\s+\w+\s*\{", re.MULTILINE)
+
+
 def show_lines(type_name: str, comments: bool = True, nested_comments: bool = False, level: int = 0,
                read: Callable[[str], str] = installed_definition) -> list[str]:
     """The definition of ``type_name`` (its text from ``read``) with every nested message expanded one
-    tab deeper."""
+    tab deeper; an IDL-only definition as it is written."""
     package = type_name.split("/")[0]
+    definition = read(type_name)
+    if IDL_MODULE.search(definition):
+        return [f"{chr(9) * level}{line.rstrip()}" if line.strip() else "" for line in definition.splitlines()]
     lines = []
-    for raw in read(type_name).splitlines():
+    for raw in definition.splitlines():
         text = raw.rstrip()
         start = _comment_start(text)
         comment = _comment_text(text[start + 1:]) if start >= 0 else ""

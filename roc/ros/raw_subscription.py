@@ -95,13 +95,21 @@ def _info(info: _Info) -> dict[str, Any]:
 
 
 class RawSubscription:
-    """A raw subscription on ``node``, read by ``take()``: [(CDR bytes, info)] (info: see ``_info``)."""
+    """A raw subscription on ``node``, read by ``take()``: [(CDR bytes, info)] (info: see ``_info``).
+    With ``content_filter`` (expression, parameters), the middleware filters its messages where it can;
+    ``unfiltered`` then says why it does not (None when it does)."""
 
-    def __init__(self, node, msg_type: type, topic: str, qos: QoSProfile) -> None:
+    def __init__(self, node, msg_type: type, topic: str, qos: QoSProfile,
+                 content_filter: tuple[str, list[str]] | None = None) -> None:
         check_is_valid_msg_type(msg_type)
         self._rcl, self._rcutils = _libraries()
         with node.handle:
             self._handle = _rclpy.Subscription(node.handle, msg_type, topic, qos.get_c_qos_profile())
+        self.unfiltered: str | None = None
+        if content_filter is not None:
+            from roc.ros.middleware_filter import set_filter
+
+            self.unfiltered = set_filter(node, self._handle, msg_type, topic, *content_filter)
         self._buffer = _Bytes()
         allocator = self._rcutils.rcutils_get_default_allocator()
         if self._rcutils.rcutils_uint8_array_init(ctypes.byref(self._buffer), 0, ctypes.byref(allocator)) != RCL_RET_OK:
@@ -150,12 +158,15 @@ class Receiver:
         self._thread = threading.Thread(target=self._take_all, name="roc-receiver", daemon=True)
         self._thread.start()
 
-    def subscribe(self, key: Hashable, msg_type: type, topic: str, qos: QoSProfile) -> None:
-        """Receive ``topic``'s messages as ``key``'s."""
-        subscription = RawSubscription(self._node, msg_type, topic, qos)
+    def subscribe(self, key: Hashable, msg_type: type, topic: str, qos: QoSProfile,
+                  content_filter: tuple[str, list[str]] | None = None) -> str | None:
+        """Receive ``topic``'s messages as ``key``'s; with ``content_filter``, returns why the
+        middleware does not filter them (None when it does, see RawSubscription)."""
+        subscription = RawSubscription(self._node, msg_type, topic, qos, content_filter)
         with self._changed:
             self._subscriptions[key] = subscription
         self._wake.trigger_guard_condition()
+        return subscription.unfiltered
 
     def _take_all(self) -> None:
         wait_set: Any = None  # an rclpy WaitSet with room for ``size`` subscriptions

@@ -6,13 +6,14 @@ dispatched: it returns why the package must be tested again (``never tested``, `
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 from roc.builder.environment import build_environment
 from roc.builder.fingerprint import combine
 from roc.buildtypes.context import BuildOptions
 from roc.engine.events import task_key
-from roc.engine.process import TaskContext
+from roc.engine.process import RanElsewhere, TaskContext
 from roc.engine.ready import Task
 from roc.testing.cache import (
     read_test_state,
@@ -28,15 +29,20 @@ from roc.workspace.package import Package
 KIND = "test"
 
 
+# Runs a package's tests elsewhere (roc.cluster.remote_test): whether they all passed, and where they ran.
+TestRunner = Callable[[TaskContext, "PackageTest"], tuple[bool, RanElsewhere | None]]
+
+
 def plan_tests(workspace: Workspace, options: TestOptions, weights: dict[str, float], force: bool = False,
-               use_cache: bool = True) -> list[Task]:
+               use_cache: bool = True, runner: TestRunner | None = None) -> list[Task]:
     """One task per selected package, after the selected packages it depends on (as colcon orders
-    tests)."""
+    tests); a ``runner`` runs them instead of this machine (a cluster)."""
     tasks = []
     for package in workspace.selected_in_order():
         dependencies = workspace.dependencies.in_order(package.name)
         test = PackageTest(package, (workspace.root / package.path).resolve(), dependencies, options, force,
                            use_cache)
+        test.runner = runner
         key = task_key(KIND, package.name)
         tasks.append(Task(
             name=package.name,
@@ -62,6 +68,7 @@ class PackageTest:
         self.build_dir = options.build_base / package.name
         self.parts: dict | None = None
         self.files: dict = {}
+        self.runner: TestRunner | None = None
 
     def check(self) -> list[str]:
         if not self.use_cache:
@@ -73,19 +80,24 @@ class PackageTest:
             return ["--force"]
         return rerun_reasons(state, self.parts)
 
-    def run(self, context: TaskContext) -> None:
-        # For testing, the package's own install prefix is part of its environment (as in colcon).
-        environment_options = BuildOptions(build_base=self.options.build_base,
-                                           install_base=self.options.install_base,
-                                           merge_install=self.options.merge_install)
-        env = build_environment(self.package, [*self.dependencies, self.package.name], environment_options)
+    def run(self, context: TaskContext) -> RanElsewhere | None:
         self.build_dir.mkdir(parents=True, exist_ok=True)
         if self.use_cache:
             write_test_state(self.build_dir, None, False, self.files, [])
-        passed = run_package_tests(context, self.package.type, self.package.name, self.source, env, self.options)
+        passed, elsewhere = self.runner(context, self) if self.runner else (self.run_here(context), None)
         if self.use_cache:
             results: set[str] = set()
             collect_results(self.options.result_dir(self.package.name), files=results)
             key = combine(self.parts) if self.parts else None
             write_test_state(self.build_dir, key, passed, self.files, sorted(str(Path(p).absolute()) for p in results),
                              self.parts)
+        return elsewhere
+
+    def run_here(self, context: TaskContext) -> bool:
+        """Run the package's tests on this machine; whether they all passed."""
+        # For testing, the package's own install prefix is part of its environment (as in colcon).
+        environment_options = BuildOptions(build_base=self.options.build_base,
+                                           install_base=self.options.install_base,
+                                           merge_install=self.options.merge_install)
+        env = build_environment(self.package, [*self.dependencies, self.package.name], environment_options)
+        return run_package_tests(context, self.package.type, self.package.name, self.source, env, self.options)

@@ -3,10 +3,15 @@
 Two kinds of files count: JUnit/xUnit XML (any ``*.xml`` whose root is ``testsuite`` or ``testsuites``,
 in directories not starting with a dot) and CTest results (``Testing/TAG`` naming the latest
 ``Testing/<tag>/Test.xml``). Files that are neither are skipped, as colcon skips them.
+
+Beyond colcon, each result says which of its tests never started and why (``not_started``): a test
+file pytest could not import, or that skipped itself while being imported, or a run that wrote no
+result file at all. colcon shows those only as "collection failure" (with --verbose).
 """
 
 from __future__ import annotations
 
+import ast
 import copy
 import os
 from dataclasses import dataclass, field
@@ -20,6 +25,10 @@ COUNTS = ("tests", "errors", "failures", "skipped")
 # colcon's attribute -> count mapping; None marks a required attribute.
 SUITE_ATTRIBUTES = (("tests", "tests", None), ("errors", "errors", 0), ("failures", "failures", None),
                     ("skipped", "skip", 0), ("skipped", "skipped", 0), ("skipped", "disabled", 0))
+# pytest's messages for a test file it could not import, or that skipped itself while being imported;
+# the test case roc and colcon write before pytest runs, which stays when pytest writes no result file
+COLLECTION_FAILURE, COLLECTION_SKIPPED = "collection failure", "collection skipped"
+MISSING_RESULT_CASE = "pytest.missing_result"
 
 
 class NotAResultFile(ValueError):
@@ -36,6 +45,7 @@ class Result:
     failures: int = 0
     skipped: int = 0
     details: list[str] = field(default_factory=list)
+    not_started: list[str] = field(default_factory=list)  # why tests never started, one line each
     # The file's test suites as JUnit elements, for merging into one report.
     suites: list = field(default_factory=list, repr=False)
 
@@ -43,6 +53,7 @@ class Result:
         for name in COUNTS:
             setattr(self, name, getattr(self, name) + getattr(other, name))
         self.details += other.details
+        self.not_started += other.not_started
 
     @property
     def ok(self) -> bool:
@@ -56,7 +67,8 @@ class Result:
                 f"{plural(self.failures, 'failure')}, {self.skipped} skipped")
 
     def as_dict(self) -> dict:
-        return {"path": self.path, **{name: getattr(self, name) for name in COUNTS}, "details": self.details}
+        return {"path": self.path, **{name: getattr(self, name) for name in COUNTS}, "details": self.details,
+                "not_started": self.not_started}
 
 
 def _messages(label: str, messages: list[str]) -> list[str]:
@@ -92,6 +104,41 @@ def _testcase_details(case) -> str | None:
                       *_messages("stdout output", outs), *_messages("stderr output", errs)])
 
 
+def _test_file(case) -> str:
+    """The test file of pytest's test case for a whole file (``test.test_copyright``: test/test_copyright.py)."""
+    return case.get("name", "").replace(".", "/") + ".py"
+
+
+def _last_error_line(text: str | None) -> str:
+    """The exception of pytest's report of an error: its last ``E   `` line (else its last line)."""
+    lines = [line for line in (text or "").splitlines() if line.strip()]
+    errors = [line[1:].strip() for line in lines if line.startswith("E ")]
+    return (errors or lines or ["(no details)"])[-1].strip()
+
+
+def _skip_reason(text: str | None) -> str:
+    """The reason of pytest's ``collection skipped`` case, whose text is ``(file, line, "Skipped: why")``."""
+    try:
+        reason = str(ast.literal_eval(text or "")[2])
+    except (ValueError, SyntaxError, TypeError, IndexError):
+        reason = (text or "").strip()
+    return reason.removeprefix("Skipped: ")
+
+
+def _not_started(case) -> str | None:
+    """Why the tests of a test case never started, or None: ``error collecting FILE: EXCEPTION``,
+    ``skipped collecting FILE: REASON``, or the message of a run that wrote no result file."""
+    for child in case:
+        message = child.get("message", "")
+        if child.tag == "error" and message == COLLECTION_FAILURE:
+            return f"error collecting {_test_file(case)}: {_last_error_line(child.text)}"
+        if child.tag == "skipped" and message == COLLECTION_SKIPPED:
+            return f"skipped collecting {_test_file(case)}: {_skip_reason(child.text)}"
+        if child.tag == "failure" and case.get("name") == MISSING_RESULT_CASE:
+            return message
+    return None
+
+
 def _suite_result(suite, details: bool) -> Result:
     result = Result("")
     for name, attribute, default in SUITE_ATTRIBUTES:
@@ -107,9 +154,10 @@ def _suite_result(suite, details: bool) -> Result:
         if value < 0:
             raise NotAResultFile(f"the '{attribute}' attribute should be a positive integer")
         setattr(result, name, getattr(result, name) + value)
+    cases = [case for case in suite if case.tag == "testcase"]
+    result.not_started = [reason for case in cases for reason in [_not_started(case)] if reason]
     if details:
-        result.details = [text for case in suite if case.tag == "testcase"
-                          for text in [_testcase_details(case)] if text]
+        result.details = [text for case in cases for text in [_testcase_details(case)] if text]
     result.suites = [suite]
     return result
 
@@ -129,6 +177,14 @@ def parse_junit(path: str, details: bool = False) -> Result:
         result.add(part)
         result.suites += part.suites
     return result
+
+
+def not_started(path: Path) -> list[str]:
+    """Why the tests of a result file never started (empty when they all did, or the file is unreadable)."""
+    try:
+        return parse_junit(str(path)).not_started
+    except (NotAResultFile, etree.XMLSyntaxError, OSError):
+        return []
 
 
 def _junit_results(base: Path, details: bool, files: set[str] | None) -> list[Result]:

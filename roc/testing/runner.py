@@ -10,8 +10,9 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
-from roc.engine.events import TestFailures
+from roc.engine.events import TestFailures, TestsNotRun
 from roc.engine.process import TaskContext, TaskError
+from roc.testing.results import not_started
 
 CTEST_TESTS_FAILED = 8
 PYTEST_TESTS_FAILED = 1
@@ -163,10 +164,15 @@ def pytest_addopts(name: str, source: Path, options: TestOptions) -> tuple[list[
 MISSING_RESULT = """<?xml version="1.0" encoding="UTF-8"?>
 <testsuite name="{name}" tests="1" failures="0" time="0" errors="1" skipped="0">
   <testcase classname="{name}" name="pytest.missing_result" time="0">
-    <failure message="The test invocation failed without generating a result file."/>
+    <failure message="The test invocation failed without generating a result file{why}."/>
   </testcase>
 </testsuite>
 """
+
+
+def _reasons(reasons: list[str]) -> str:
+    """The first reason, and how many more there are."""
+    return reasons[0] + (f" (and {len(reasons) - 1} more)" if len(reasons) > 1 else "")
 
 
 def _pytest(context: TaskContext, name: str, source: Path, env: dict[str, str], options: TestOptions) -> bool:
@@ -175,11 +181,20 @@ def _pytest(context: TaskContext, name: str, source: Path, env: dict[str, str], 
     env.setdefault("PYTHONDONTWRITEBYTECODE", "1")
     junit = options.result_dir(name) / "pytest.xml"
     junit.parent.mkdir(parents=True, exist_ok=True)
-    junit.write_text(MISSING_RESULT.format(name=name))  # replaced by pytest unless it fails early
+    placeholder = MISSING_RESULT.format(name=name, why="")
+    junit.write_text(placeholder)  # replaced by pytest unless it fails early
     returncode = context.run([sys.executable, "-m", "pytest"], cwd=str(source), env=env)
     if returncode == PYTEST_TESTS_FAILED:
         context.emit(TestFailures(context.name, context.kind))
         return False
-    if returncode not in (0, PYTEST_NO_TESTS):
-        raise TaskError(f"pytest exited with code {returncode}")
+    if returncode == PYTEST_NO_TESTS:
+        reasons = not_started(junit)
+        context.emit(TestsNotRun(context.name, context.kind, reason=_reasons(reasons) if reasons else ""))
+    elif returncode != 0:
+        if junit.read_text() == placeholder:  # no result file: pytest's stderr, shown with the task, says why
+            junit.write_text(MISSING_RESULT.format(name=name, why=f" (pytest exited with code {returncode})"))
+            raise TaskError(f"pytest exited with code {returncode}")
+        # why, where colcon says only "exited with code 2": the test files pytest could not import
+        reasons = not_started(junit)
+        raise TaskError(f"pytest exited with code {returncode}" + (f": {_reasons(reasons)}" if reasons else ""))
     return True

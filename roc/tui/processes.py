@@ -18,10 +18,8 @@ from typing import Any
 
 import psutil
 
+from roc.ros.discovery import is_metatraffic_port, process_bits
 from roc.ros.protocol import full_name
-
-EPROSIMA = "01.0f"
-PORT_BASE, DOMAIN_GAIN, PARTICIPANT_GAIN, METATRAFFIC_UNICAST = 7400, 250, 2, 10
 
 
 @dataclass(frozen=True)
@@ -33,9 +31,10 @@ class Participant:
 def participant(gid: str) -> Participant | None:
     """The participant of an endpoint gid (``01.0f.7f.01.f3.5f...``), None when it is not Fast DDS's."""
     parts = gid.split(".")
-    if len(parts) < 12 or ".".join(parts[:2]) != EPROSIMA:
+    bits = process_bits(bytes(int(part, 16) for part in parts[:12])) if len(parts) >= 12 else None
+    if bits is None:
         return None
-    return Participant(".".join(parts[:12]), int(parts[4], 16) | int(parts[5], 16) << 8)
+    return Participant(".".join(parts[:12]), bits)
 
 
 def node_participants(snapshot: dict[str, Any]) -> dict[str, Participant]:
@@ -48,12 +47,6 @@ def node_participants(snapshot: dict[str, Any]) -> dict[str, Participant]:
             if name not in found and (found_participant := participant(endpoint["gid"])) is not None:
                 found[name] = found_participant
     return found
-
-
-def is_metatraffic_port(port: int, domain: int) -> bool:
-    """A metatraffic unicast port of a participant of ``domain``."""
-    offset = port - PORT_BASE - DOMAIN_GAIN * domain - METATRAFFIC_UNICAST
-    return 0 <= offset < DOMAIN_GAIN - METATRAFFIC_UNICAST and offset % PARTICIPANT_GAIN == 0
 
 
 @dataclass

@@ -9,8 +9,10 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping
 
+from roc.distribution import detected
+
 # ROS 2 defaults, used when the environment does not set them (e.g. a Python venv with the ROS
-# wheels, where no setup script has exported them).
+# wheels, where no setup script has exported them); ROS_DISTRO's is that of the sourced ROS 2's rclpy.
 DEFAULT_VARIABLES = {"ROS_VERSION": "2", "ROS_PYTHON_VERSION": "3"}
 
 _TOKEN = re.compile(r"""\s*(?:(\()|(\))|(==|!=|<=|>=|<|>)|(\$\w+)|"([^"]*)"|'([^']*)'|([^\s()=!<>$"']+))""")
@@ -30,7 +32,8 @@ class ConditionError(ValueError):
 
 def condition_environment(environ: Mapping[str, str]) -> dict[str, str]:
     """The variables conditions see: the environment over roc's ROS 2 defaults."""
-    return {**DEFAULT_VARIABLES, **environ}
+    found = detected(environ) if environ.get("AMENT_PREFIX_PATH") and not environ.get("ROS_DISTRO") else None
+    return {**DEFAULT_VARIABLES, **({"ROS_DISTRO": found[0]} if found else {}), **environ}
 
 
 def evaluate_condition(text: str | None, variables: Mapping[str, str]) -> bool:

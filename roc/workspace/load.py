@@ -7,6 +7,7 @@ import os
 import sys
 from pathlib import Path
 
+from roc.environment import with_implicit_underlay
 from roc.workspace.cache import cached_discovery
 from roc.workspace.conditions import condition_environment
 from roc.workspace.dependencies import DependencyIndex, topological_order
@@ -62,7 +63,7 @@ def discover_workspace(root: Path, base_paths: list[str] | None = None,
 
 def _discover(root: Path, base_paths: list[str] | None, paths: list[str] | None) -> tuple[list[Package], bool]:
     """``discover_workspace``'s packages, and whether they are in topological order already."""
-    variables = condition_environment(os.environ)
+    variables = condition_environment(with_implicit_underlay(os.environ))
 
     def discover(visited: list[str]) -> list[Package]:
         from roc.workspace.discovery import discover_packages

@@ -12,15 +12,18 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 
 from roc.errors import UsageError
-from roc.messages import unknown_package, warn
+from roc.messages import did_you_mean, unknown_package, warn
 from roc.workspace.dependencies import DependencyIndex
 from roc.workspace.package import Package
 
-# Options that take package names, checked against the workspace.
-NAME_OPTIONS = (
-    "packages_up_to", "packages_above", "packages_above_and_dependencies", "packages_select_by_dep",
-    "packages_skip_by_dep", "packages_skip_up_to", "packages_select", "packages_skip", "packages_ignore",
-)
+# Options that take package names. An unknown name in one of IGNORED_WHEN_UNKNOWN is left out with a
+# warning, so command lines shared between repositories keep working: colcon warns for --packages-select,
+# -skip and -ignore and says nothing for the others. The other options name where a selection starts
+# (or ends), which an unknown name leaves without meaning: an error, as in colcon.
+IGNORED_WHEN_UNKNOWN = ("packages_select", "packages_skip", "packages_ignore", "packages_select_by_dep",
+                        "packages_skip_by_dep", "packages_skip_up_to")
+REQUIRED_TO_EXIST = ("packages_up_to", "packages_above", "packages_above_and_dependencies")
+# Patterns that match nothing: an error for --packages-up-to-regex (as in colcon), else a warning.
 REGEX_OPTIONS = ("packages_ignore_regex", "packages_up_to_regex", "packages_select_regex", "packages_skip_regex")
 INTERRUPTED_RESULT = "SIGINT"
 
@@ -29,29 +32,44 @@ def _matches(patterns: Iterable[str] | None, name: str) -> bool:
     return any(re.match(p, name) for p in patterns or ())
 
 
+def _flag(option: str) -> str:
+    return f"--{option.replace('_', '-')}"
+
+
 def check_selection_arguments(args: argparse.Namespace, names: set[str]) -> None:
-    """Unknown package names and invalid patterns are usage errors that say what to do."""
+    """Unknown package names are left out with a warning or are usage errors (see IGNORED_WHEN_UNKNOWN);
+    invalid patterns are usage errors."""
     depth_args = getattr(args, "packages_above_depth", None) or []
     if depth_args:
         if not depth_args[0].isdigit():
             raise UsageError("--packages-above-depth: the first value must be a depth (0, 1, ...), "
                              f"not '{depth_args[0]}'")
-    checks = [(option, getattr(args, option, None) or []) for option in NAME_OPTIONS]
+    for option in IGNORED_WHEN_UNKNOWN:
+        for name in getattr(args, option, None) or []:
+            if name not in names and name not in (getattr(args, "packages", None) or []):
+                hint = did_you_mean(name, names)
+                warn(f"ignoring unknown package '{name}' in {_flag(option)}{'; ' + hint if hint else ''}")
+    # the names typed as the verb's own arguments (roc work test PKG...) are meant, never shared: they must exist
+    checks = [("", getattr(args, "packages", None) or [])]
+    checks += [(option, getattr(args, option, None) or []) for option in REQUIRED_TO_EXIST]
     checks += [("packages_above_depth", depth_args[1:]),
                ("packages_start", [args.packages_start] if args.packages_start else []),
                ("packages_end", [args.packages_end] if args.packages_end else [])]
     for option, values in checks:
         for name in values:
             if name not in names:
-                raise UsageError(f"--{option.replace('_', '-')}: {unknown_package(name, names)}")
+                raise UsageError(f"{_flag(option) + ': ' if option else ''}{unknown_package(name, names)}")
     for option in REGEX_OPTIONS:
         for pattern in getattr(args, option, None) or []:
             try:
                 re.compile(pattern)
             except re.error as error:
-                raise UsageError(f"--{option.replace('_', '-')}: invalid pattern '{pattern}': {error}") from None
+                raise UsageError(f"{_flag(option)}: invalid pattern '{pattern}': {error}") from None
             if not any(re.match(pattern, n) for n in names):
-                warn(f"--{option.replace('_', '-')} '{pattern}' matches no package name")
+                if option == "packages_up_to_regex":
+                    raise UsageError(f"{_flag(option)} '{pattern}' matches no package name; run 'roc work list -n' "
+                                     "to see the package names")
+                warn(f"{_flag(option)} '{pattern}' matches no package name")
 
 
 def ignore_packages(args: argparse.Namespace, packages: list[Package]) -> list[Package]:

@@ -84,6 +84,7 @@ def test_bag_directory_split_in_files_is_read_across_them(rosbag2_reference):
         assert len(bag.files) == 5 and bag.metadata.version == 4
 
 
+@pytest.mark.distro
 def test_info_text_is_ros2_bag_infos(rosbag2_reference, tmp_path):
     bag = RESOURCES / "mcap" / "talker"
     size = sum(f.stat().st_size for f in bag.iterdir()) / 1024
@@ -144,6 +145,7 @@ def write_test_msgs(uri: Path, rounds: int = 3, **options) -> dict[str, list[byt
     return written
 
 
+@pytest.mark.distro
 @pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
 def test_written_bag_is_read_back_byte_identical_by_roc_and_rosbags(tmp_path, storage):
     from rosbags.rosbag2 import Reader
@@ -255,6 +257,7 @@ def test_presets_write_readable_files(tmp_path):
 
 # ---- convert, reindex -----------------------------------------------------------------------------
 
+@pytest.mark.distro
 def test_convert_merges_splits_and_windows(rosbag2_reference, tmp_path):
     options = tmp_path / "out.yaml"
     options.write_text(yaml.safe_dump({"output_bags": [

@@ -60,6 +60,7 @@ def _events_until(process: subprocess.Popen, topic: str, seconds: float = 20) ->
     return events
 
 
+@pytest.mark.distro
 def test_topics_arrive_in_the_other_domain_with_their_qos(domains) -> None:
     a, b = domains
     bridge = start_bridge("--from-domain", a["ROS_DOMAIN_ID"], "--to-domain", b["ROS_DOMAIN_ID"], "/chatter", "latched",

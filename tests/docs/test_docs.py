@@ -13,7 +13,16 @@ import sys
 from pathlib import Path
 
 import pytest
-from helpers.docs_examples import REPO, Sequence, matches, pages, sequences
+from helpers.docs_examples import (
+    REPO,
+    Sequence,
+    matches,
+    pages,
+    reader_environment,
+    sequences,
+    split_at_interrupt,
+    unchecked_output_blocks,
+)
 from helpers.oracles import SHARED, require_oracle
 
 from roc.cli.commands import build_parser
@@ -116,23 +125,36 @@ def test_example_comments_are_read_in_page_order(tmp_path: Path) -> None:
     assert [(c.command, c.expected) for c in slow.commands] == [("roc c", [])]
 
 
+def test_live_examples_name_their_graph_files_and_ctrl_c(tmp_path: Path) -> None:
+    page = tmp_path / "page.md"
+    page.write_text("<!-- example file: roc.toml -->\n```toml\n[check]\n```\n"
+                    "<!-- example: workspaces/example, graph demo -->\n```console\n$ roc topic hz /r\nrate\n^C\n"
+                    "roc: interrupted\n```\n<!-- not run: two machines -->\n```console\n$ a\nb\n```\n"
+                    "```console\n$ only a command\n```\n```console\n$ c\nshown, never run\n```\n")
+    (live,) = sequences(page)
+    assert (live.graph, live.files, live.commands[0].expected) == ("demo", {"roc.toml": "[check]\n"},
+                                                                   ["rate", "^C", "roc: interrupted"])
+    assert split_at_interrupt(live.commands[0].expected) == (["rate"], ["roc: interrupted"])
+    assert split_at_interrupt(["a"]) == (["a"], None)
+    assert unchecked_output_blocks(page) == [20]  # the last block
+
+
 def _all_sequences() -> list:
     params = []
     for page in pages():
         for sequence in sequences(page):
+            if sequence.graph:
+                continue  # tests/docs/test_docs_live_graph.py runs them beside their graph
             marks = [pytest.mark.slow] if sequence.slow else []
             params.append(pytest.param(sequence, id=sequence.name, marks=marks))
     return params
 
 
-def _environment(home: Path) -> dict[str, str]:
-    """A reader's shell: no ROS environment sourced (roc's own .venv is the underlay), nobody's colcon
-    settings, Python's byte-code writing on (as on a machine without PYTHONDONTWRITEBYTECODE)."""
-    drop = ("AMENT_PREFIX_PATH", "CMAKE_PREFIX_PATH", "COLCON_PREFIX_PATH", "PYTHONPATH", "PYTHONDONTWRITEBYTECODE",
-            "COLCON_DEFAULTS_FILE", "ROC_CACHE_DIR", "XDG_CACHE_HOME", "MAKEFLAGS", "CMAKE_GENERATOR", "NO_COLOR")
-    env = {k: v for k, v in os.environ.items() if k not in drop and not k.startswith("ROC_")}
-    env.update(HOME=str(home), PATH=f"{BIN}{os.pathsep}{env.get('PATH', '/usr/bin:/bin')}", PYTHONUNBUFFERED="1")
-    return env
+def test_every_console_block_that_shows_output_is_run_or_says_why_not() -> None:
+    """Output pasted once drifts from what roc prints: a block showing output is an example that runs
+    (beside a live graph if it shows one), or says why it cannot (``<!-- not run: two machines -->``)."""
+    unchecked = {str(page.relative_to(REPO)): lines for page in pages() if (lines := unchecked_output_blocks(page))}
+    assert not unchecked, f"console blocks with output that are neither run nor say why not (page: lines): {unchecked}"
 
 
 @pytest.mark.parametrize("sequence", _all_sequences())
@@ -144,7 +166,7 @@ def test_the_examples_print_what_the_page_shows(sequence: Sequence, tmp_path: Pa
     shutil.copytree(REPO / sequence.directory, directory, symlinks=True,
                     ignore=shutil.ignore_patterns("build", "install", "log", "__pycache__"))
     (tmp_path / "home").mkdir()
-    env = _environment(tmp_path / "home")
+    env = reader_environment(tmp_path / "home")
     for command in sequence.commands:
         result = subprocess.run(["bash", "-c", command.command], cwd=directory, env=env, stdin=subprocess.DEVNULL,
                                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)

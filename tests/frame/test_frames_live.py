@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -14,8 +13,8 @@ import time
 from pathlib import Path
 
 import pytest
-from helpers.build import BIN, NODES, REPO, roc, stop_process
-from helpers.graph import graph_env, read_line, stop_daemon
+from helpers.build import BIN, NODES, stop_process
+from helpers.graph import graph_env, read_line, stop_daemon, with_tf2_msgs
 
 pytestmark = pytest.mark.slow
 TF_NODE = NODES / "tf_node.py"
@@ -24,15 +23,7 @@ TF_NODE = NODES / "tf_node.py"
 @pytest.fixture(scope="module")
 def sourced(tmp_path_factory):
     """A graph environment with the built tf2_msgs sourced."""
-    workspace = tmp_path_factory.mktemp("tf")
-    shutil.copytree(REPO / "workspaces" / "example" / "src" / "tf2_msgs", workspace / "src" / "tf2_msgs")
-    built = roc("work", "build", cwd=workspace)
-    assert built.returncode == 0, built.stdout + built.stderr
-    env = graph_env(6, tmp_path_factory.mktemp("runtime"))
-    dumped = subprocess.run(["bash", "-c", f'source "{workspace}/install/setup.bash" && env -0'], env=env,
-                            capture_output=True, timeout=60)
-    assert dumped.returncode == 0, dumped.stderr
-    env = dict(item.split("=", 1) for item in dumped.stdout.decode().split("\0") if "=" in item)
+    env = with_tf2_msgs(graph_env(6, tmp_path_factory.mktemp("runtime")))
     yield env
     stop_daemon(env)
 

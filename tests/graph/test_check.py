@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 
 import pytest
-from helpers.graph import graph_env, roc, start_nodes, stop_all, stop_daemon
+from helpers.graph import graph_env, roc, start_nodes, stop_all, stop_daemon, wait_for
 
 from roc.check.expectations import load_checks
 from roc.errors import UsageError
@@ -130,11 +130,59 @@ def test_a_snapshot_checks_green_against_its_system(graph, tmp_path: Path, flags
     assert topics["topic /chatter"]["type"] == "std_msgs/msg/String"
     assert topics["topic /chatter"]["min-rate"] < 20 < topics["topic /chatter"]["max-rate"]
     assert {label: (values["publishers"], values["subscribers"]) for label, values in topics.items()} == {
-        "topic /chatter": (1, 1), "topic /scan": (1, 1), "topic /parameter_events": (3, 0), "topic /rosout": (3, 0)}
+        "topic /chatter": (1, 1), "topic /scan": (1, 1)}  # not /rosout, /parameter_events: every node adds to them
     result = roc("graph", "check", "--file", str(tmp_path / "snapshot.toml"), *flags, env=graph)
     # /scan's publisher and subscriber cannot match: the snapshot records the system, incompatible or not
     failed = [line for line in result.stdout.splitlines() if line.startswith("Failed")]
     assert [line.split(" [")[0] for line in failed] == ["Failed   <<< topic /scan"], result.stdout
+
+
+@pytest.mark.slow
+def test_a_snapshot_still_holds_when_one_more_node_joins(graph, tmp_path: Path) -> None:
+    """A snapshot pins the system's own topics, not those every node publishes on (/rosout,
+    /parameter_events), whose counts change whenever any node starts."""
+    snapshot = roc("graph", "snapshot", "--rate-window", "0", env=graph)
+    assert snapshot.returncode == 0, snapshot.stderr
+    (tmp_path / "snapshot.toml").write_text(snapshot.stdout)
+    newcomer = start_nodes([{"name": "newcomer"}], graph)
+    try:
+        wait_for(lambda: "/newcomer" in roc("node", "list", env=graph).stdout.split())
+        result = roc("graph", "check", "--file", str(tmp_path / "snapshot.toml"), env=graph)
+    finally:
+        stop_all(newcomer)
+    failed = [line.split(" [")[0] for line in result.stdout.splitlines() if line.startswith("Failed")]
+    assert failed == ["Failed   <<< topic /scan"], result.stdout  # its QoS never matched (see above)
+
+
+# What roc graph snapshot writes: the nodes one a line, services and actions as inline tables.
+SNAPSHOT = """# roc graph snapshot: ...
+[check]
+nodes = [
+    "/listener",
+    "/motor",  # the motor's node
+]
+service = [
+    { name = "/motor/enable", type = "std_srvs/srv/SetBool", request = "{data: [1, 2]}" },
+    { name = "/motor/reset", type = "std_srvs/srv/Trigger" },
+]
+action = [{ name = "/fibonacci", type = "test_msgs/action/Fibonacci" }]
+
+[[check.topic]]
+name = "/chatter"
+
+[[check.topic]]
+name = "/scan"
+"""
+
+
+def test_each_expectation_points_at_its_own_line(tmp_path: Path) -> None:
+    """A failing probe names the line of its entry (a node's name, a [[check.topic]] table, an inline
+    table), not the [check] header."""
+    (tmp_path / "snapshot.toml").write_text(SNAPSHOT)
+    checks = load_checks(tmp_path / "snapshot.toml")
+    assert {e.label: int(e.where.rsplit(":", 1)[1]) for e in checks.expectations} == {
+        "node /listener": 4, "node /motor": 5, "service /motor/enable": 8, "service /motor/reset": 9,
+        "action /fibonacci": 11, "topic /chatter": 13, "topic /scan": 16}
 
 
 @pytest.mark.parametrize("text, error", [

@@ -11,11 +11,10 @@ import json
 import os
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 from helpers.build import BIN, NODES, stop_process
-from helpers.graph import graph_env, read_line, roc, start_nodes, stop_all, stop_daemon, wait_for
+from helpers.graph import component_prefix, graph_env, read_line, roc, start_nodes, stop_all, stop_daemon, wait_for
 
 pytestmark = pytest.mark.slow
 
@@ -68,6 +67,7 @@ def test_lifecycle_list_all_is_the_whole_transition_graph(managed):
                                                           "\tGoal: finalized\n")
 
 
+@pytest.mark.distro
 def test_lifecycle_set_walks_a_node_through_its_states(managed):
     env = managed
     configured = roc("lifecycle", "set", "/arm", "configure", env=env)
@@ -89,23 +89,6 @@ def test_lifecycle_set_walks_a_node_through_its_states(managed):
 
 
 # ---- components ---------------------------------------------------------------------------------
-
-def component_prefix(root: Path) -> Path:
-    """An install prefix registering demo_components' two components and rclcpp_components' container
-    executable (tests/nodes/container_node.py), as an rclcpp install would."""
-    index = root / "share" / "ament_index" / "resource_index"
-    for package in ("demo_components", "rclcpp_components", "no_components"):
-        (index / "packages").mkdir(parents=True, exist_ok=True)
-        (index / "packages" / package).write_text("")
-    (index / "rclcpp_components").mkdir()
-    (index / "rclcpp_components" / "demo_components").write_text(
-        "demo_components::Talker;lib/libtalker.so\ndemo_components::Listener;lib/liblistener.so\n")
-    container = root / "lib" / "rclcpp_components" / "component_container"
-    container.parent.mkdir(parents=True)
-    container.write_text(f"#!/bin/sh\nexec {sys.executable} {NODES / 'container_node.py'} \"$@\"\n")
-    container.chmod(0o755)
-    return root
-
 
 @pytest.fixture(scope="module")
 def box(tmp_path_factory):

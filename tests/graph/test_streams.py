@@ -38,6 +38,7 @@ def graph(tmp_path_factory):
     stop_all(processes)
 
 
+@pytest.mark.distro
 @pytest.mark.parametrize("daemon", [True, False], ids=["daemon", "no-daemon"])
 def test_echo_once_prints_a_message_as_ros2_does(graph, daemon: bool) -> None:
     env, _ = graph
@@ -94,6 +95,7 @@ def _received(listener: subprocess.Popen, count: int, timeout: float = 10.0) -> 
     return lines
 
 
+@pytest.mark.distro
 @pytest.mark.parametrize("daemon", [True, False], ids=["daemon", "no-daemon"])
 def test_pub_reaches_a_real_subscriber(graph, daemon: bool) -> None:
     env, listener = graph
@@ -170,6 +172,7 @@ def _run_for(seconds: float, *args: str, env: dict[str, str]) -> tuple[int, str,
     return process.returncode, out, err
 
 
+@pytest.mark.distro
 def test_hz_bw_and_delay_measure_live_topics(graph) -> None:
     from rclpy.serialization import serialize_message
     from std_msgs.msg import String
@@ -199,6 +202,7 @@ def test_hz_bw_and_delay_measure_live_topics(graph) -> None:
     assert 0 <= delay["min"] <= delay["delay"] <= delay["max"] < 0.5
 
 
+@pytest.mark.distro
 @pytest.mark.parametrize("daemon", [True, False], ids=["daemon", "no-daemon"])
 def test_service_call_prints_request_and_response_as_ros2_does(graph, daemon: bool) -> None:
     env, _ = graph
@@ -246,6 +250,7 @@ def test_param_set_delete_and_a_dump_loaded_back(graph, tmp_path) -> None:
                                                      "mapping (see 'roc param load --help')\n")
 
 
+@pytest.mark.distro
 @pytest.mark.parametrize("daemon", [True, False], ids=["daemon", "no-daemon"])
 def test_send_goal_with_feedback_and_result(graph, daemon: bool) -> None:
     env, _ = graph

@@ -8,12 +8,17 @@ import subprocess
 import sys
 from pathlib import Path
 
+from roc import distribution
+
 REPO = Path(__file__).resolve().parents[2]
 FIXTURES = REPO / "workspaces" / "fixtures"
 TESTS = REPO / "tests"
 NODES = TESTS / "nodes"  # the scripts the tests run as ROS nodes
 DATA = TESTS / "data"
 BIN = Path(sys.executable).parent
+# The ROS 2 distribution of the venv that runs the tests (scripts/setup.sh: .venv Jazzy, .venv-kilted Kilted)
+DISTRO = distribution.current({}).name
+REQUIREMENTS = REPO / "requirements" / f"ros-{DISTRO}.txt"  # its wheels, as scripts/setup.sh installed them
 ENV_VARIABLES = ("AMENT_PREFIX_PATH", "CMAKE_PREFIX_PATH", "PYTHONPATH", "PATH", "LD_LIBRARY_PATH",
                  "COLCON_PREFIX_PATH")
 
@@ -102,7 +107,7 @@ def package_dsv_files(install: Path) -> dict[str, str]:
 
 # Each test file that starts ROS participants has a slot of its own; a slot is one ROS domain per
 # pytest-xdist worker, counted from ROC_TEST_DOMAIN_BASE (default 20). Two test runs on one machine (two
-# checkouts, or a person beside a robot on domain 20) stay apart with, e.g., ROC_TEST_DOMAIN_BASE=120.
+# checkouts, or a person beside a robot on domain 20) stay apart with, e.g., ROC_TEST_DOMAIN_BASE=90.
 DOMAIN_SLOTS = 66
 DOMAIN_MAX = 232  # Fast DDS's highest domain id (its UDP ports are derived from it)
 

@@ -11,12 +11,14 @@ import threading
 import time
 from pathlib import Path
 
-from helpers.build import BIN, ros_domain_id, stop_process
+from helpers.build import BIN, DISTRO, REQUIREMENTS, ros_domain_id, stop_process
 from helpers.build import roc as roc_build
 from helpers.oracles import SHARED, require_oracle
 
 NODE_SCRIPT = Path(__file__).resolve().parents[1] / "nodes" / "graph_node.py"
-ORACLE_VENV = Path(os.environ.get("ROC_TEST_CACHE", Path.home() / ".cache" / "roc-tests")) / "ros2cli-venv"
+# the real ros2 CLI, in a venv of the tests' distribution's wheels (Jazzy's keeps its first name)
+ORACLE_VENV = (Path(os.environ.get("ROC_TEST_CACHE", Path.home() / ".cache" / "roc-tests"))
+               / ("ros2cli-venv" if DISTRO == "jazzy" else f"ros2cli-venv-{DISTRO}"))
 REPO = Path(__file__).resolve().parents[2]
 
 # The demo graph of shared/reference/ros2cli, in three processes.
@@ -98,6 +100,23 @@ def threads(process: subprocess.Popen) -> list[tuple[str, Path]]:
     return [(task.joinpath("comm").read_text().strip(), task) for task in Path(f"/proc/{process.pid}/task").iterdir()]
 
 
+def component_prefix(root: Path) -> Path:
+    """An install prefix registering demo_components' two components and rclcpp_components' container
+    executable (tests/nodes/container_node.py), as an rclcpp install would."""
+    index = root / "share" / "ament_index" / "resource_index"
+    for package in ("demo_components", "rclcpp_components", "no_components"):
+        (index / "packages").mkdir(parents=True, exist_ok=True)
+        (index / "packages" / package).write_text("")
+    (index / "rclcpp_components").mkdir(exist_ok=True)
+    (index / "rclcpp_components" / "demo_components").write_text(
+        "demo_components::Talker;lib/libtalker.so\ndemo_components::Listener;lib/liblistener.so\n")
+    container = root / "lib" / "rclcpp_components" / "component_container"
+    container.parent.mkdir(parents=True, exist_ok=True)
+    container.write_text(f"#!/bin/sh\nexec {sys.executable} {NODE_SCRIPT.with_name('container_node.py')} \"$@\"\n")
+    container.chmod(0o755)
+    return root
+
+
 def stop_all(processes: list[subprocess.Popen]) -> None:
     for process in processes:
         stop_process(process)
@@ -112,8 +131,12 @@ def ros2(*args: str, env: dict[str, str], timeout: float = 60) -> subprocess.Com
                           timeout=timeout)
 
 
-# The message packages the oracle needs to echo and publish the tests' types, as requirements/ros-jazzy.txt pins them.
-ORACLE_INTERFACES = ("ros-jazzy-std-msgs", "ros-jazzy-common-interfaces", "ros-jazzy-std-srvs", "ros-jazzy-test-msgs")
+# The message packages the oracle needs to echo and publish the tests' types, as requirements/ros-DISTRO.txt pins them.
+ORACLE_INTERFACES = tuple(f"ros-{DISTRO}-{name}" for name in ("std-msgs", "common-interfaces", "std-srvs", "test-msgs"))
+
+
+# The oracles' installers take the wheels of the venv's distribution, which an empty venv does not tell
+INSTALLER_ENV = {**os.environ, "ROS_WHEELS_DISTRO": DISTRO}
 
 
 def install_oracle(launch: bool = False) -> str | None:
@@ -123,7 +146,7 @@ def install_oracle(launch: bool = False) -> str | None:
     import fcntl
 
     ORACLE_VENV.parent.mkdir(parents=True, exist_ok=True)
-    with open(ORACLE_VENV.parent / "ros2cli-venv.lock", "w") as lock:
+    with open(ORACLE_VENV.parent / f"{ORACLE_VENV.name}.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         return _install_ros2cli() or (_install_launch() if launch else None)
 
@@ -143,10 +166,11 @@ def _install_ros2cli() -> str | None:
         made = subprocess.run([base, "-m", "venv", str(ORACLE_VENV)], capture_output=True, text=True)
         if made.returncode != 0:
             return f"cannot create {ORACLE_VENV}: {made.stderr.strip()}"
-    installed = subprocess.run(["bash", str(script), str(ORACLE_VENV)], capture_output=True, text=True, timeout=900)
+    installed = subprocess.run(["bash", str(script), str(ORACLE_VENV)], capture_output=True, text=True, timeout=900,
+                               env=INSTALLER_ENV)
     if installed.returncode != 0:
         return f"install_ros2cli.sh failed: {installed.stderr.strip()[-300:]}"
-    pins = [line.strip() for line in (REPO / "requirements" / "ros-jazzy.txt").read_text().splitlines()
+    pins = [line.strip() for line in REQUIREMENTS.read_text().splitlines()
             if line.strip().startswith(tuple(f"{name}==" for name in ORACLE_INTERFACES))]
     added = subprocess.run([str(python), "-m", "pip", "install", "-q", *pins], capture_output=True, text=True,
                            timeout=900)
@@ -157,7 +181,7 @@ def _install_ros2cli() -> str | None:
 
 def _install_launch() -> str | None:
     """``ros2 launch`` in the oracle venv. install_launch.sh builds composition_interfaces with CMake, which
-    needs what roc's own venv has for that: the wheels of requirements/ros-jazzy.txt with their CMake
+    needs what roc's own venv has for that: the wheels of requirements/ros-DISTRO.txt with their CMake
     fix-ups, and catkin_pkg (ament_cmake reads package.xml with it; roc's venv has it through colcon)."""
     if (ORACLE_VENV / "bin" / "ros2").exists() and _oracle_imports("ros2launch, launch_ros, launch_xml, launch_yaml"):
         return None
@@ -165,11 +189,11 @@ def _install_launch() -> str | None:
     if not script.is_file():
         return f"no launch installer at {script}"
     python = str(ORACLE_VENV / "bin" / "python")
-    steps = [[python, "-m", "pip", "install", "-q", "-r", str(REPO / "requirements" / "ros-jazzy.txt"), "catkin-pkg"],
+    steps = [[python, "-m", "pip", "install", "-q", "-r", str(REQUIREMENTS), "catkin-pkg"],
              [python, str(REPO / "scripts" / "fix_ros_wheels.py"), "--quiet"],
              ["bash", str(script), str(ORACLE_VENV)]]
     for step in steps:
-        done = subprocess.run(step, capture_output=True, text=True, timeout=900)
+        done = subprocess.run(step, capture_output=True, text=True, timeout=900, env=INSTALLER_ENV)
         if done.returncode != 0:
             return f"{' '.join(step[:4])} failed: {(done.stderr or done.stdout).strip()[-300:]}"
     return None

@@ -6,10 +6,12 @@ from __future__ import annotations
 
 import os
 import re
+import subprocess
 from pathlib import Path
 
 import pytest
-from helpers.graph import install_oracle, roc, ros2, stop_daemon
+from helpers.build import BIN
+from helpers.graph import ORACLE_VENV, install_oracle, roc, ros2, stop_daemon
 from helpers.launch import (
     demo_env,
     describe,
@@ -150,3 +152,48 @@ def test_a_broken_launch_file_fails_as_in_ros2_launch(demo, tmp_path: Path) -> N
 
     assert error(ours.stdout + ours.stderr) == error(theirs.stdout + theirs.stderr)
     assert "NameError: name 'undefined_action' is not defined" in ours.stdout
+
+
+HELLO = """from launch import LaunchDescription
+from launch.actions import ExecuteProcess
+
+
+def generate_launch_description():
+    return LaunchDescription([ExecuteProcess(cmd=["echo", "hello"], name="hello", output="screen")])
+"""
+
+
+def _log_directory(output: str) -> Path:
+    """The directory the launch library's "All log files can be found below DIR" line names."""
+    found = re.search(r"All log files can be found below (\S+)", output)
+    assert found, output
+    return Path(found[1])
+
+
+@pytest.mark.slow
+def test_outside_a_workspace_the_logs_go_where_ros2_launch_writes_them(demo, tmp_path: Path) -> None:
+    """Not into ./log of wherever the user stands: $ROS_LOG_DIR, else $ROS_HOME/log, else ~/.ros/log (the
+    launch library's rule, compared with it in test_launch_logic.py), in a run directory named as ros2 launch
+    names its own. In a workspace, its log/ as for builds."""
+    env, _ = demo
+    (tmp_path / "hello.launch.py").write_text(HELLO)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    base = tmp_path / "ros_log_dir"
+    outputs = [subprocess.run([str(tool), "launch", "../hello.launch.py"], cwd=elsewhere,
+                              env={**env, "ROS_LOG_DIR": str(base)}, capture_output=True, text=True, timeout=120)
+               for tool in (ORACLE_VENV / "bin" / "ros2", BIN / "roc")]
+    theirs, ours = (_log_directory(output.stdout + output.stderr) for output in outputs)
+    assert theirs.parent == base
+    assert ours.name == "launch" and ours.parent.parent == base  # the launch library's own log in launch/
+    run = ours.parent
+    assert re.fullmatch(r"\d{4}(-\d\d){5}-\d{6}-.+-\d+", run.name) and (base / "latest").resolve() == run
+    assert "hello" in (run / "hello-1.log").read_text().splitlines() and (ours / "launch.log").is_file()
+    assert list(elsewhere.iterdir()) == []
+
+    workspace = tmp_path / "ws"
+    (workspace / "src").mkdir(parents=True)
+    inside = subprocess.run([str(BIN / "roc"), "launch", str(tmp_path / "hello.launch.py")], cwd=workspace / "src",
+                            env=env, capture_output=True, text=True, timeout=120)
+    assert _log_directory(inside.stdout).parent == (workspace / "log" / "latest_launch").resolve()
+    assert (workspace / "log" / "latest_launch" / "hello-1.log").is_file()

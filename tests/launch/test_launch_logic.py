@@ -223,7 +223,8 @@ def test_a_system_reads_into_processes_conditions_and_ros_arguments(tmp_path: Pa
 
 
 def test_the_plan_starts_processes_after_their_conditions(tmp_path: Path) -> None:
-    from roc.launch.plan import LazySession, explain, plan, start_order
+    from roc.launch.explain import system_entries, system_lines
+    from roc.launch.plan import LazySession, plan, start_order
     from roc.launch.system import load_system
 
     (tmp_path / "roc.toml").write_text(SYSTEM)
@@ -235,7 +236,9 @@ def test_the_plan_starts_processes_after_their_conditions(tmp_path: Path) -> Non
         "process:map_server"}
     assert [task.key for task in start_order(tasks) if task.kind == "process"] == [
         "process:map_server", "process:robot/amcl", "process:scan"]  # by depth, then as declared
-    assert explain(system, tasks, lambda spec: [spec.executable, *spec.arguments]) == [
+    entries = system_entries(system, tasks, lambda spec: [spec.executable, *spec.arguments], dict,
+                             lambda _spec: "/")
+    assert system_lines(system, entries) == [
         f"[launch.nav] of {tmp_path}/roc.toml: 3 processes; conditions wait up to 12 s",
         "map_server: starts at once", "    map_server --verbose",
         "robot/amcl: starts after: service /map_server/load_map is available, topic /scan publishes at >= 5 Hz, "
@@ -258,3 +261,17 @@ def test_roc_toml_with_launch_systems_still_configures_the_work_verbs(tmp_path: 
     (tmp_path / "roc.toml").write_text(SYSTEM + '\n[build]\nparallel-workers = 3\n')
     config = load_configuration(tmp_path, "build", None, metas=[], ignore_user_meta=True)
     assert config.effective()["parallel-workers"].value == 3
+
+
+@pytest.mark.parametrize("variables", [{"ROS_LOG_DIR": "/tmp/roc-logs/../roc-logs2"}, {"ROS_LOG_DIR": "~/logs"},
+                                       {"ROS_HOME": "/tmp/roc-home"}, {"ROS_LOG_DIR": "", "ROS_HOME": ""}, {}])
+def test_the_ros_log_directory_is_the_launch_librarys(variables: dict[str, str], monkeypatch) -> None:
+    """Where ros2 launch writes its logs (roc launch's logs outside a workspace): the launch library's own rule."""
+    logging = pytest.importorskip("launch.logging")
+    from roc.launch.logs import ros_log_directory
+
+    for name in ("ROS_LOG_DIR", "ROS_HOME"):
+        monkeypatch.delenv(name, raising=False)
+    for name, value in variables.items():
+        monkeypatch.setenv(name, value)
+    assert str(ros_log_directory()) == logging._get_logging_directory()

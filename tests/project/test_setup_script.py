@@ -10,7 +10,7 @@ from pathlib import Path
 
 from helpers.build import REPO
 
-# what the set-up runs, without zsh, fish, tmux and ccache
+# what the set-up runs, without zsh, fish, tmux, ccache and sshd
 TOOLS = ("bash", "dirname", "sha256sum", "cut", "cat", "flock", "grep", "env", "rm")
 
 
@@ -42,17 +42,17 @@ def test_the_set_up_installs_no_system_package_unless_asked(tmp_path: Path) -> N
     run, asked = _setup_without_shells(tmp_path)
     assert run.returncode == 0, run.stderr
     assert asked == ""
-    assert "setup: zsh fish tmux ccache not installed: their tests will be skipped (ROC_SETUP_TEST_TOOLS=1 installs them)" in run.stderr
+    assert "setup: zsh fish tmux ccache openssh-server not installed: their tests will be skipped (ROC_SETUP_TEST_TOOLS=1 installs them)" in run.stderr
 
 
 def test_roc_setup_test_tools_installs_zsh_fish_tmux_and_ccache_and_says_so(tmp_path: Path) -> None:
     run, asked = _setup_without_shells(tmp_path, ROC_SETUP_TEST_TOOLS="1")
     assert run.returncode == 0, run.stderr
-    assert "setup: ROC_SETUP_TEST_TOOLS=1: installing zsh fish tmux ccache with apt-get" in run.stderr
-    assert asked.splitlines() == ["update -qq", "install -y -qq zsh fish tmux ccache"]
+    assert "setup: ROC_SETUP_TEST_TOOLS=1: installing zsh fish tmux ccache openssh-server with apt-get" in run.stderr
+    assert asked.splitlines() == ["update -qq", "install -y -qq zsh fish tmux ccache openssh-server"]
 
 
 def test_ci_opts_in_and_the_set_up_says_what_the_option_does() -> None:
     assert "export ROC_SETUP_TEST_TOOLS=1" in (REPO / ".ci" / "run").read_text()
     header = (REPO / "scripts" / "setup.sh").read_text().split("set -euo pipefail")[0]
-    assert "ROC_SETUP_TEST_TOOLS=1  also install zsh, fish, tmux and ccache" in header
+    assert "ROC_SETUP_TEST_TOOLS=1  also install zsh, fish, tmux, ccache and openssh-server" in header

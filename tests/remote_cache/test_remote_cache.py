@@ -69,6 +69,7 @@ def warm(dav, tmp_path_factory):
     return ci
 
 
+@pytest.mark.distro
 def test_fresh_checkout_elsewhere_restores_everything_and_runs(dav, warm, tmp_path):
     url, _, env = dav
     dev = _checkout(tmp_path / "another place", "dev checkout")  # another path, with spaces

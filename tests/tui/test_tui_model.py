@@ -150,7 +150,8 @@ def test_plot_points_are_thinned_keeping_spikes_and_written_as_csv() -> None:
 
 
 def test_a_participant_gid_names_its_process_bits_and_a_domain_port() -> None:
-    from roc.tui.processes import is_metatraffic_port, participant
+    from roc.ros.discovery import is_metatraffic_port
+    from roc.tui.processes import participant
 
     found = participant("01.0f.7f.01.f3.5f.c1.23.00.00.00.00.00.00.03.03")
     assert found is not None and found.pid_bits == 0x5FF3 and found.prefix == "01.0f.7f.01.f3.5f.c1.23.00.00.00.00"

@@ -53,6 +53,7 @@ def drive(test) -> None:
     asyncio.run(test())
 
 
+@pytest.mark.distro
 def test_lists_counts_rates_problems_and_filter(graph) -> None:
     async def test() -> None:
         app = RocApp()

@@ -14,7 +14,6 @@ from helpers.build import (
     comparable_install_files,
     in_sourced_shell,
     package_dsv_files,
-    roc,
     ros_domain_id,
     sourced_values,
     stop_process,
@@ -22,18 +21,15 @@ from helpers.build import (
 )
 from helpers.powershell import check_package_scripts, parse
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("example_workspace")]  # built once for the manual too
 
 
 @pytest.fixture(scope="module")
-def example(tmp_path_factory):
-    ws = tmp_path_factory.mktemp("example")
-    shutil.copytree(REPO / "workspaces" / "example" / "src", ws / "src")
-    result = roc("work", "build", "--parallel-workers", "2", cwd=ws)
-    assert result.returncode == 0, result.stdout + result.stderr
-    return ws
+def example(example_workspace):
+    return example_workspace
 
 
+@pytest.mark.distro
 def test_cpp_executables_and_interfaces(example):
     ran = in_sourced_shell(example, "install/demo_tools/lib/demo_tools/filter_demo; demo_plain; "
                                     "python -c 'from demo_interfaces.msg import Reading; "
@@ -52,6 +48,7 @@ def test_powershell_scripts(example):
                           merged=False)
 
 
+@pytest.mark.distro
 def test_python_node_messages_arrive(example):
     env = {"HOME": os.environ.get("HOME", "/tmp"), "PATH": f"{BIN}:/usr/bin:/bin", "ROS_DOMAIN_ID": ros_domain_id(5),
            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST", "RMW_IMPLEMENTATION": "rmw_fastrtps_cpp"}

@@ -42,6 +42,7 @@ def _reasons(stdout: str) -> dict[str, list[str]]:
     return {e["task"]: e["reasons"] for e in events if e["event"] == "TaskStarted"}
 
 
+@pytest.mark.distro
 def test_results_equal_colcon_and_are_cached(tmp_path: Path) -> None:
     workspace = copy_fixture("testing", tmp_path / "ws")
     built = roc("work", "build", cwd=workspace)
@@ -165,3 +166,33 @@ def test_clean_then_build_rebuilds_what_was_removed(tmp_path: Path) -> None:
     assert "Starting >>> t_a" in rebuilt.stdout and "Starting >>> t_b" not in rebuilt.stdout
     assert roc("work", "test", "--output", "json", cwd=workspace).returncode == 0
     assert (workspace / "build" / "t_a" / "pytest.xml").exists()
+
+
+
+def test_tests_that_cannot_start_say_why_on_the_console_and_in_test_result(tmp_path: Path) -> None:
+    """pytest exits 2 when it cannot import a test file, 5 when it collected no test: colcon says only
+    "exited with code 2" (or nothing), the reason stays in log/latest_test/<pkg>/stdout_stderr.log.
+    my_node's linter tests import ament_copyright, ament_flake8 and ament_pep257 (as ``ros2 pkg create``'s
+    do), which the PyPI wheels lack; my_tools's only test skips itself without ament_flake8."""
+    workspace = copy_fixture("tests_not_started", tmp_path / "ws")
+    assert roc("work", "build", cwd=workspace).returncode == 0
+    reasons = [f"error collecting test/test_{linter}.py: ModuleNotFoundError: No module named 'ament_{linter}'"
+               for linter in ("copyright", "flake8", "pep257")]
+    skipped = ("skipped collecting test/test_flake8.py: could not import 'ament_flake8.main': "
+               "No module named 'ament_flake8'")
+
+    tested = roc("work", "test", cwd=workspace)
+    assert tested.returncode == 1
+    failed = f"pytest exited with code 2: {reasons[0]} (and 2 more)"
+    assert re.search(rf"^Failed   <<< my_node \[[\d.]+s, {re.escape(failed)}\]$", tested.stdout, re.M), tested.stdout
+    assert re.search(rf"^Finished <<< my_tools \[[\d.]+s\]\t\[ no tests ran: {re.escape(skipped)} \]$",
+                     tested.stdout, re.M), tested.stdout
+
+    results = roc("work", "test-result", "--all", cwd=workspace)
+    assert "".join(f"  {reason}\n" for reason in reasons) in results.stdout
+    assert f"build/my_tools/pytest.xml: 1 test, 0 errors, 0 failures, 1 skipped\n  {skipped}\n" in results.stdout
+    data = json.loads(roc("work", "test-result", "--format", "json", cwd=workspace).stdout)
+    assert [(r["path"], r["not_started"]) for r in data["results"]] == [("build/my_node/pytest.xml", reasons)]
+    events = [json.loads(line) for line in (workspace / "log" / "latest_test" / "events.log").read_text().splitlines()]
+    assert {e["task"]: e["reason"] for e in events if e["event"] in ("TaskFailed", "TestsNotRun")} == {
+        "my_node": failed, "my_tools": skipped}

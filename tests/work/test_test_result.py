@@ -105,3 +105,33 @@ def test_delete(results: Path) -> None:
 def test_missing_base_is_a_usage_error(tmp_path: Path) -> None:
     result = roc("work", "test-result", "--test-result-base", "nowhere", cwd=tmp_path)
     assert result.returncode == 2 and "'nowhere' does not exist" in result.stderr
+
+
+# pytest's result when it could not import one test file and another skipped itself while imported
+NOT_STARTED = """<?xml version="1.0" encoding="utf-8"?><testsuites name="pytest tests"><testsuite name="pytest"
+ errors="1" failures="0" skipped="1" tests="2"><testcase classname="p" name="test.test_copyright" time="0.000">
+<error message="collection failure">ImportError while importing test module '/ws/src/p/test/test_copyright.py'.
+Traceback:
+test/test_copyright.py:1: in &lt;module&gt;
+    from ament_copyright.main import main
+E   ModuleNotFoundError: No module named 'ament_copyright'</error></testcase>
+<testcase classname="" name="test.test_flake8" time="0.000"><skipped message="collection skipped">('/ws/src/p/test/test_flake8.py', 2, "Skipped: could not import 'ament_flake8': No module named 'ament_flake8'")</skipped></testcase>
+</testsuite></testsuites>
+"""
+
+
+def test_tests_that_never_started_are_shown_with_why(tmp_path: Path) -> None:
+    """colcon test-result shows only 'collection failure', and only with --verbose."""
+    import json
+
+    (tmp_path / "build" / "p").mkdir(parents=True)
+    (tmp_path / "build" / "p" / "pytest.xml").write_text(NOT_STARTED)
+    reasons = ["error collecting test/test_copyright.py: ModuleNotFoundError: No module named 'ament_copyright'",
+               "skipped collecting test/test_flake8.py: could not import 'ament_flake8': No module named 'ament_flake8'"]
+    result = roc("work", "test-result", cwd=tmp_path)
+    assert result.returncode == 1
+    assert result.stdout == ("build/p/pytest.xml: 2 tests, 1 error, 0 failures, 1 skipped\n"
+                             + "".join(f"  {reason}\n" for reason in reasons)
+                             + "\nSummary: 2 tests, 1 error, 0 failures, 1 skipped\n")
+    assert json.loads(roc("work", "test-result", "--format", "json", cwd=tmp_path).stdout)["results"][0][
+        "not_started"] == reasons

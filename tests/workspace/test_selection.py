@@ -147,14 +147,12 @@ def test_skipped_packages_stay_in_the_graph() -> None:
 
 @pytest.mark.parametrize("argv, message", [
     (("--packages-up-to", "ap"), "--packages-up-to: no package named 'ap' in the workspace; did you mean app?"),
-    (("--packages-select", "nothing_like_it"), "run 'roc work list -n' to see the package names"),
-    (("--packages-skip", "x"), "--packages-skip: no package named 'x'"),
-    (("--packages-ignore", "x"), "--packages-ignore: no package named 'x'"),
+    (("--packages-above", "nothing_like_it"), "run 'roc work list -n' to see the package names"),
     (("--packages-above-depth", "1", "x"), "--packages-above-depth: no package named 'x'"),
     (("--packages-above-depth", "one", "core"), "the first value must be a depth"),
     (("--packages-start", "x"), "--packages-start: no package named 'x'"),
     (("--packages-end", "x"), "--packages-end: no package named 'x'"),
-    (("--packages-select-by-dep", "x"), "--packages-select-by-dep: no package named 'x'"),
+    (("--packages-up-to-regex", "zzz"), "--packages-up-to-regex 'zzz' matches no package name"),
     (("--packages-skip-regex", "[a-"), "--packages-skip-regex: invalid pattern '[a-'"),
     (("--packages-start", "tool", "--packages-end", "core"),
      "--packages-end 'core' comes before --packages-start 'tool'"),
@@ -164,6 +162,71 @@ def test_usage_errors(argv: tuple[str, ...], message: str) -> None:
         selected(*argv)
     assert message in str(error.value)
     assert error.value.exit_code == 2
+
+
+# What colcon does with a name the workspace lacks, option by option: warn and go on, go on, or stop.
+COLCON_WARNS = ("--packages-select", "--packages-skip", "--packages-ignore")
+COLCON_SAYS_NOTHING = ("--packages-select-by-dep", "--packages-skip-by-dep", "--packages-skip-up-to")
+COLCON_REFUSES = ("--packages-up-to", "--packages-above", "--packages-above-and-dependencies")
+
+
+def test_an_unknown_name_in_a_name_list_is_ignored_with_a_warning(capsys: pytest.CaptureFixture[str]) -> None:
+    assert selected("--packages-skip", "not_here", "cor", "util") == [n for n in ORDER if n != "util"]
+    assert capsys.readouterr().err == ("roc: warning: ignoring unknown package 'not_here' in --packages-skip\n"
+                                       "roc: warning: ignoring unknown package 'cor' in --packages-skip; "
+                                       "did you mean 'core'?\n")
+    assert selected("--packages-select", "not_here", "app") == ["app"]
+    assert selected("--packages-select-by-dep", "not_here") == []
+    assert selected("--packages-ignore", "not_here", "--packages-skip-up-to", "not_here", "lib_a") == [
+        "extra", "standalone", "test_helper", "util", "lib_b", "app", "tool"]
+
+
+@pytest.mark.slow  # runs the real colcon
+def test_unknown_names_are_ignored_or_refused_option_by_option_as_colcon_does(tmp_path: Path) -> None:
+    """So that a command line shared between repositories (--packages-skip of a package only some have) keeps
+    working: where colcon goes on (with a warning, or without one) roc goes on with a warning; where an
+    unknown name leaves the selection without meaning (where it starts or ends), both stop."""
+    import subprocess
+
+    from helpers.build import BIN, ros_env
+
+    workspace = copy_fixture("selection", tmp_path / "ws")
+    known = {"--packages-select": "app lib_a util tool", "--packages-skip": "tool", "--packages-ignore": "standalone",
+             "--packages-select-by-dep": "core", "--packages-skip-by-dep": "extra", "--packages-skip-up-to": "msgs"}
+    going_on = [word for option in COLCON_WARNS + COLCON_SAYS_NOTHING
+                for word in (option, f"no_{option[11:]}", *known[option].split())]
+    refused = [word for option in COLCON_REFUSES for word in (option, "not_here")]
+    runs = {"going on": going_on, "refused": refused, "start": ["--packages-start", "not_here"],
+            "end": ["--packages-end", "not_here"]}
+    # colcon takes about a second to start: all at once
+    colcons = {run: subprocess.Popen([str(BIN / "colcon"), "list", "-n", *words], cwd=workspace, env=ros_env(),
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+               for run, words in runs.items()}
+    outputs = {run: (*process.communicate(timeout=120), process.returncode) for run, process in colcons.items()}
+    ours = {run: roc("work", "list", "-n", *words, cwd=workspace) for run, words in runs.items()}
+
+    out, err, code = outputs["going on"]
+    assert (code, ours["going on"].returncode) == (0, 0) and out.split() and ours["going on"].stdout == out
+    for option in COLCON_WARNS + COLCON_SAYS_NOTHING:
+        warning = f"ignoring unknown package 'no_{option[11:]}' in {option}"
+        assert (warning in err) == (option in COLCON_WARNS), (option, err)
+        assert f"roc: warning: {warning}\n" in ours["going on"].stderr
+    out, err, code = outputs["refused"]
+    assert code != 0 and err.splitlines() == [f"Package 'not_here' specified with {option} was not found"
+                                              for option in COLCON_REFUSES]
+    assert ours["refused"].returncode == 2 and ours["refused"].stderr.startswith(
+        f"roc: error: {COLCON_REFUSES[0]}: no package named 'not_here' in the workspace")
+    for run in ("start", "end"):
+        assert outputs[run][2] != 0 and outputs[run][1].strip() == f"Package 'not_here' specified with --packages-{run} was not found"
+        assert ours[run].returncode == 2 and f"--packages-{run}: no package named 'not_here'" in ours[run].stderr
+
+
+def test_a_package_named_as_the_verbs_argument_must_exist(tmp_path: Path) -> None:
+    """``roc work test PKG`` is short for --packages-select PKG, but a name typed there is meant: an error."""
+    workspace = copy_fixture("selection", tmp_path / "ws")
+    result = roc("work", "test", "ap", cwd=workspace)
+    assert result.returncode == 2
+    assert result.stderr.startswith("roc: error: no package named 'ap' in the workspace; did you mean app?")
 
 
 def test_pattern_that_matches_nothing_warns(capsys: pytest.CaptureFixture[str]) -> None:

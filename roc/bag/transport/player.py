@@ -46,7 +46,7 @@ class PlayOptions:
     loop: bool = False
     clock_hz: float = 0.0
     selection: Selection | None = None  # None: every topic
-    remaps: dict[str, str] = field(default_factory=dict)
+    remaps: list[str] = field(default_factory=list)  # OLD:=NEW rules, applied by rcl to the player's node
     overrides: dict[str, dict[str, Any]] = field(default_factory=dict)
     start_offset: float = 0.0  # seconds
     delay: float = 0.0  # seconds before each play
@@ -169,7 +169,6 @@ class Player:
                            "holds no message definition of it roc could build (rclpy can only publish types whose "
                            "generated code is installed); install or source its package")
                 continue
-            name = options.remaps.get(topic.name, options.remaps.get(_absolute(topic.name), topic.name))
             override = options.overrides.get(_absolute(topic.name)) or options.overrides.get(topic.name)
             qos = override
             if qos is None:
@@ -177,7 +176,7 @@ class Player:
                 if mixed:
                     self._warn(f"the publishers of {topic.name} offered different QoS profiles when it was "
                                "recorded: playing it with the default profile")
-            publishers[topic.name] = graph.node.create_publisher(cls, name, profile(qos))
+            publishers[topic.name] = graph.node.create_publisher(cls, topic.name, profile(qos))
         return publishers, skipped
 
     def _read(self, bag: Bag, topics: list[str], start: int, end: int | None, ready: queue.Queue) -> None:
@@ -215,7 +214,8 @@ class Player:
         published: dict[str, int] = {}
         lateness: list[int] = []
         with Bag(options.bag, options.storage) as bag:
-            graph = Graph()
+            # the remappings are the node's, as rosbag2 passes them to its player: to its topics and /clock
+            graph = Graph(arguments=["--ros-args", *(word for rule in options.remaps for word in ("--remap", rule))])
             try:
                 publishers, skipped = self._publishers(graph, bag)
                 if not publishers:

@@ -62,6 +62,7 @@ class Result:
     paused_dropped: int
     before_clock_dropped: int
     error: str | None = None
+    repeated: int = 0  # transient local messages written again at the start of split files
 
 
 def _clock_ns(data: bytes) -> int | None:
@@ -120,11 +121,17 @@ class Recorder:
             wanted = self.options.overrides.get(name) or request_for_offers(offers)
             type_hash = next((str(p.topic_type_hash) for p in publishers if str(p.topic_type_hash)), "") or (
                 type_hash_of(type_name))
-            writer.add_topic(Topic(name, type_name, "cdr", offers, type_hash), definition(type_name))
+            topic = Topic(name, type_name, "cdr", offers, type_hash)
+            writer.add_topic(topic, definition(type_name))
+            if name in self.options.write.repeat_transient_local and wanted["durability"] != "transient_local":
+                self._warn(f"topic {name} is repeated in each file (--repeat-transient-local) but not every "
+                           "publisher offers it transient local: a late recorder may miss its messages")
             receiver.subscribe(name, cls, name, profile(wanted, depth=None if name in self.options.overrides
                                                        else RECEIVE_DEPTH))
             self._subscribed[name] = TopicStats()
-            self._report(f"Subscribed to topic '{name}'")
+            depth = self.options.write.repeat_depth(topic)
+            repeated = f" (repeat-transient-local, depth={depth})" if depth else ""
+            self._report(f"Subscribed to topic '{name}'{repeated}")
 
     def _write(self, writer: BagWriter, batch: list) -> None:
         for key, data, info in batch:
@@ -198,4 +205,5 @@ class Recorder:
                 error = error or str(full)
                 metadata = writer.metadata()
             graph.close()
-        return Result(metadata, self._subscribed, self._paused_dropped, self._before_clock_dropped, error)
+        return Result(metadata, self._subscribed, self._paused_dropped, self._before_clock_dropped, error,
+                      writer.repeated)

@@ -79,14 +79,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--disable-keyboard-controls", action="store_true", help="no keyboard controls")
 
 
-def _remaps(rules: list[str]) -> dict[str, str]:
-    remaps = {}
+def _remaps(rules: list[str]) -> list[str]:
     for rule in rules:
         old, separator, new = rule.partition(":=")
         if not separator or not old or not new:
             raise UsageError(f"--remap: '{rule}' is not OLD:=NEW")
-        remaps[old] = new
-    return remaps
+    return rules
 
 
 def _selection(args: argparse.Namespace) -> Selection | None:

@@ -55,6 +55,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                        help="mcap: none, fastwrite, zstd_fast, zstd_small; sqlite3: none, resilient")
     files.add_argument("--custom-data", nargs="*", default=[], metavar="KEY=VALUE",
                        help="store these in the bag's metadata (custom_data)")
+    files.add_argument("--repeat-transient-local", nargs="*", metavar="TOPIC[=DEPTH]",
+                       help="begin each split file with the latest DEPTH (default 1) messages of these topics, "
+                            "so that each file plays alone (/tf_static, /map); without topics: of every topic "
+                            "offered transient local")
+    files.add_argument("--repeat-all-transient-local", nargs="?", type=int, const=1, default=0, metavar="DEPTH",
+                       help="as --repeat-transient-local for every topic offered transient local (rosbag2's "
+                            "spelling; DEPTH defaults to 1)")
     parser.add_argument("--start-paused", action="store_true", help="start paused (space resumes)")
     parser.add_argument("--use-sim-time", action="store_true",
                         help="stamp messages with /clock's time; nothing is written before the first /clock")
@@ -95,6 +102,22 @@ def _custom_data(pairs: list[str]) -> dict[str, str]:
     return data
 
 
+def repeat_options(given: list[str] | None, every: int) -> tuple[dict[str, int], int]:
+    """``--repeat-transient-local TOPIC[=DEPTH] ...`` as {topic: depth} and the depth of every transient
+    local topic (``--repeat-all-transient-local``, or the option alone)."""
+    if given is None:
+        return {}, every
+    if not given:
+        return {}, every or 1
+    depths = {}
+    for entry in given:
+        topic, equals, depth = entry.partition("=")
+        if not topic or (equals and not depth.isdigit()) or (equals and int(depth) == 0):
+            raise UsageError(f"--repeat-transient-local: '{entry}' is not TOPIC or TOPIC=DEPTH (a positive number)")
+        depths[topic if topic.startswith("/") else f"/{topic}"] = int(depth) if equals else 1
+    return depths, every
+
+
 def _summary(result, uri: str) -> list[str]:
     metadata = result.metadata
     lines = [f"Recorded {metadata.message_count} messages on {len(metadata.topics)} topics into {uri} "
@@ -104,6 +127,8 @@ def _summary(result, uri: str) -> list[str]:
                              header=["topic", "received", "written", "lost"])
     lost = sum(s.lost for s in result.stats.values())
     lines.append(f"Lost messages: {lost} (gaps in the publishers' sequence numbers)")
+    if result.repeated:
+        lines.append(f"Repeated at the start of split files: {result.repeated} (--repeat-transient-local)")
     if result.paused_dropped:
         lines.append(f"Not written while paused: {result.paused_dropped}")
     if result.before_clock_dropped:
@@ -124,6 +149,8 @@ def run(args: argparse.Namespace) -> int:
                          max_bag_duration=args.max_bag_duration * 1_000_000_000,
                          compression_mode=args.compression_mode, compression_format=args.compression_format,
                          preset=args.storage_preset_profile, custom_data=_custom_data(args.custom_data))
+    write.repeat_transient_local, write.repeat_all_transient_local = repeat_options(
+        args.repeat_transient_local, args.repeat_all_transient_local)
     check_options(write)
     selection = _selection(args)
     overrides = load_overrides(args.qos_profile_overrides_path) if args.qos_profile_overrides_path else {}

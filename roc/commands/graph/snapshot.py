@@ -9,9 +9,11 @@ from roc.check.probes import measure_rates
 from roc.cli.options import add_discovery_arguments
 from roc.render import print_text
 
-# Services every node offers (parameters, type descriptions): left out of a snapshot.
+# Services every node offers (parameters, type descriptions) and topics every node publishes on (so that
+# their counts change whenever any node joins): left out of a snapshot.
 STANDARD_SERVICES = ("/describe_parameters", "/get_parameter_types", "/get_parameters", "/list_parameters",
                      "/set_parameters", "/set_parameters_atomically", "/get_type_description")
+EVERY_NODES_TOPICS = ("/rosout", "/parameter_events")
 RATE_MARGIN = 0.2  # min-rate and max-rate: the measured rate -/+ 20 %
 
 
@@ -30,7 +32,7 @@ def snapshot(session, rate_window: float) -> dict:
 
     graph = session.query("snapshot")
     nodes = sorted(n["full_name"] for n in graph["nodes"] if not is_hidden(n["full_name"]))
-    topics = [t for t in graph["topics"] if not is_hidden(t["name"])]
+    topics = [t for t in graph["topics"] if not is_hidden(t["name"]) and t["name"] not in EVERY_NODES_TOPICS]
     rates = measure_rates(session, [t["name"] for t in topics if t["publishers"]], rate_window)
     check: dict = {"nodes": nodes, "topic": []}
     for topic in topics:

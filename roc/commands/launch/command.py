@@ -16,7 +16,7 @@ import os
 import sys
 from pathlib import Path
 
-from roc.cli.options import add_discovery_arguments
+from roc.cli.options import add_discovery_arguments, add_format_argument
 from roc.errors import UsageError
 
 
@@ -51,15 +51,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                      help="with --check: stop the system after the report; exit 0 only when every expectation held "
                           "(a launch smoke test for CI)")
     roc.add_argument("--explain", action="store_true",
-                     help="for a roc.toml system: print what each process waits for, in start-up order, and exit")
+                     help="print what a start would run and exit, nothing started: each process's command line, "
+                          "working directory, added environment, parameters, remappings and host (and for a "
+                          "roc.toml system what it waits for, in start-up order)")
     roc.add_argument("--no-warm-start", dest="warm_start", action="store_false",
                      help="start every process with its own fresh interpreter: no Python node is forked from roc's "
                           "warm interpreter (see the manual's 'Warm start')")
     roc.add_argument("--plain", action="store_true",
                      help="plain lines on a terminal too, without the live status view")
-    roc.add_argument("--log-base", default="log", metavar="DIR",
-                     help="where the run's logs go: DIR/launch_<time>/<process>.log (default: log; "
-                          "/dev/null for none)")
+    roc.add_argument("--log-base", metavar="DIR",
+                     help="where the run's logs go: DIR/launch_<time>/<process>.log (default: log at the workspace "
+                          "root; outside a workspace, where ros2 launch writes its logs: $ROS_LOG_DIR, else "
+                          "$ROS_HOME/log, else ~/.ros/log; /dev/null for none)")
+    add_format_argument(parser)
     add_discovery_arguments(parser)
 
 
@@ -84,21 +88,27 @@ def _run_options(args: argparse.Namespace, title: str):
     check = None
     if args.check is not None:
         check = CheckOptions(args.check, args.exit_after_check, not args.no_daemon, args.spin_time)
-    root = find_workspace_root(Path.cwd()) or Path.cwd()
-    log_base = None if args.log_base == os.devnull else root / args.log_base
+    root = find_workspace_root(Path.cwd())
+    outside = root is None and args.log_base is None  # not into ./log of wherever the user stands: ros2's place
+    if outside:
+        from roc.launch.logs import ros_log_directory
+
+        log_base: Path | None = ros_log_directory()
+    else:
+        log_base = None if args.log_base == os.devnull else (root or Path.cwd()) / (args.log_base or "log")
     view = not args.plain and sys.stdout.isatty() and os.environ.get("TERM") != "dumb"
-    return RunOptions(title, log_base, view, check, args.warm_start)
+    return RunOptions(title, log_base, view, check, args.warm_start, ros_log_layout=outside)
 
 
 def run(args: argparse.Namespace) -> int:
     if args.launch_prefix_filter is not None and args.launch_prefix is None:
         raise UsageError("--launch-prefix-filter goes with --launch-prefix")
+    if args.format != "text" and not (args.explain or args.show_args):
+        raise UsageError("--format goes with --explain or --show-args")
     kind, path, words = _target(args)
     if kind == "system":
         return _run_system(args, words)
     assert path is not None
-    if args.explain:
-        raise UsageError("--explain is for the systems of roc.toml; for a launch file, use --print")
     from roc.launch.files import parse_arguments, require_launch_library
     from roc.launch.launch_file import LaunchFile, inspect, launch
 
@@ -106,9 +116,39 @@ def run(args: argparse.Namespace) -> int:
     require_launch_library()
     launch_file = LaunchFile(path, arguments, args.launch_debug, args.show_all_subprocesses_output,
                              args.launch_prefix, args.launch_prefix_filter)
-    if args.print_description or args.show_args:
-        return inspect(launch_file, "print" if args.print_description else "show-args")
+    if args.explain or args.show_args:
+        return _evaluate(args, launch_file)
+    if args.print_description:
+        return inspect(launch_file)
     return launch(launch_file, _run_options(args, f"roc launch {path.name}"))
+
+
+def _evaluate(args: argparse.Namespace, launch_file) -> int:
+    """--explain or --show-args of a launch file."""
+    from roc.launch.launch_file import argument_text, evaluate
+    from roc.render import print_json, print_lines, print_text
+
+    env = dict(os.environ)
+    if launch_file.show_all_output:
+        env["OVERRIDE_LAUNCH_PROCESS_OUTPUT"] = "both"
+    if args.show_args:
+        data = evaluate(launch_file, "show-args", env)
+        print_json(data) if args.format == "json" else print_text(argument_text(data))
+        return 0
+    from roc.launch.explain import environment_changes, file_lines, ros_arguments
+
+    entries = []
+    for process in evaluate(launch_file, "explain", env)["processes"]:
+        changed, unset = environment_changes(env, process["env"]) if process["env"] is not None else ({}, [])
+        entries.append({"name": process["name"], "host": None, "setup": [], "command": process["command"],
+                        "cwd": process["cwd"], "env": changed, "unset": unset, **ros_arguments(process["command"]),
+                        "written_parameters": process["written_parameters"], "respawn": process["respawn"],
+                        "loads": process["loads"]})
+    if args.format == "json":
+        print_json(entries)
+    else:
+        print_lines(file_lines(str(launch_file.path), entries, os.getcwd()))
+    return 0
 
 
 def _run_system(args: argparse.Namespace, words: list[str]) -> int:
@@ -127,14 +167,36 @@ def _run_system(args: argparse.Namespace, words: list[str]) -> int:
     if args.print_description or args.show_args or args.launch_prefix or args.show_all_subprocesses_output:
         raise UsageError("--print, --show-args, --launch-prefix and -a are for launch files")
     system = load_system(roc_toml, args.target)
-    if args.explain:
-        from roc.launch.plan import LazySession, explain, plan
-        from roc.launch.supervisor import command
-        from roc.render import print_lines
+    options = None if args.explain else _run_options(args, f"roc launch {args.target}")
+    found: dict[str, dict] = {}
+    if system.remote():  # every host reachable, with every executable, before anything starts
+        from roc.launch.remote import check_hosts
 
-        print_lines(explain(system, plan(system, lambda _spec: None, LazySession(), lambda: False), command))
-        return 0
+        found = check_hosts(system, dict(os.environ))
+    if options is None:
+        return _explain_system(args, system, found)
     from roc.launch.system_run import launch_system
 
-    return launch_system(system, _run_options(args, f"roc launch {args.target}"), not args.no_daemon,
-                         args.spin_time)
+    return launch_system(system, options, not args.no_daemon, args.spin_time)
+
+
+def _explain_system(args: argparse.Namespace, system, found: dict[str, dict]) -> int:
+    from roc.launch.explain import system_entries, system_lines
+    from roc.launch.plan import LazySession, plan
+    from roc.launch.remote import remote_environment
+    from roc.launch.supervisor import command
+    from roc.render import print_json, print_lines
+
+    def command_there(spec) -> list[str]:
+        if not spec.host:
+            return command(spec)
+        return [found[spec.host]["found"][f"{spec.package}/{spec.executable}"], *spec.arguments,
+                *spec.ros_arguments()]
+
+    def cwd(spec) -> str:
+        return found[spec.host]["cwd"] if spec.host else os.getcwd()
+
+    tasks = plan(system, lambda _spec: None, LazySession(), lambda: False)
+    entries = system_entries(system, tasks, command_there, remote_environment, cwd)
+    print_json(entries) if args.format == "json" else print_lines(system_lines(system, entries))
+    return 0

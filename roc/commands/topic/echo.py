@@ -7,9 +7,11 @@ import base64
 import sys
 
 from roc.cli.options import (
+    add_content_filter_arguments,
     add_graph_arguments,
     add_message_display_arguments,
     add_qos_arguments,
+    content_filter_options,
     qos_options,
 )
 from roc.commands.graph_query import publisher_wait
@@ -34,6 +36,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--raw", action="store_true", help="print the serialised (CDR) bytes")
     parser.add_argument("--filter", dest="filter_expr", metavar="EXPR",
                         help="print only messages for which this Python expression of m (the message) is true")
+    add_content_filter_arguments(parser)
     parser.add_argument("--once", action="store_true", help="print the first message and exit")
     parser.add_argument("--timeout", type=float, metavar="SECONDS",
                         help="exit with an error when no message has arrived within this time")
@@ -72,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
     params = {"topic": args.topic_name, "type": args.message_type, "qos": qos_options(args),
               # a publisher that has only just started is waited for: up to --timeout when given
               "wait": args.timeout if args.timeout is not None else publisher_wait(args),
-              "timeout": args.timeout}
+              "timeout": args.timeout, "content_filter": content_filter_options(args)}
     lost_total = 0
     type_name = args.message_type
     for event in stream("echo", params, use_daemon=not args.no_daemon):
@@ -81,6 +84,7 @@ def run(args: argparse.Namespace) -> int:
             print_text(f"WARNING: topic [{args.topic_name}] does not appear to be published yet\n")
         elif kind == "subscribed":
             type_name = event["type"]
+            note_content_filter(args.topic_name, event)
         elif kind == "timeout":
             raise RocError(f"no message on {args.topic_name} within {args.timeout:g} s (--timeout)")
         elif kind == "messages":
@@ -99,6 +103,14 @@ def run(args: argparse.Namespace) -> int:
             if args.once and texts:
                 return 0
     return 0
+
+
+def note_content_filter(topic: str, subscribed: dict) -> None:
+    """One line on stderr when roc, not the middleware, filters a topic's messages, and why."""
+    filtering = subscribed.get("content_filter") or {}
+    if filtering.get("by") == "roc":
+        print_text(f"roc: note: {filtering['reason']}: roc filters {topic}'s messages as they arrive (all of them "
+                   "still reach this subscription)\n", sys.stderr)
 
 
 def _message_text(event: dict, type_name: str, args: argparse.Namespace, accept, options: dict) -> str | None:

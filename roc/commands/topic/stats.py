@@ -8,8 +8,9 @@ import sys
 import time
 from collections.abc import Callable
 
-from roc.cli.options import add_graph_arguments
+from roc.cli.options import add_content_filter_arguments, add_graph_arguments, content_filter_options
 from roc.commands.graph_query import publisher_wait
+from roc.commands.topic.echo import note_content_filter
 from roc.errors import UsageError
 from roc.render import print_json_line, print_text
 from roc.ros.client import stream
@@ -24,6 +25,7 @@ def add_stats_arguments(parser: argparse.ArgumentParser, window: int, several: b
                         help="name of the topic" + ("s" if several else "") + " to measure, e.g. /chatter")
     parser.add_argument("-w", "--window", type=int, default=window, metavar="WINDOW",
                         help=f"measure over the last WINDOW messages (default: {window})")
+    add_content_filter_arguments(parser)
     add_graph_arguments(parser)
 
 
@@ -37,15 +39,19 @@ def watch(args: argparse.Namespace, measure: Measure, text: Text, *, stamps: boo
         raise UsageError(f"--window: must be at least 2, got {args.window}")
     windows = {topic: Window(args.window) for topic in topics}
     wait = publisher_wait(args)
-    events = _filtered(args, topics[0], accept, wait) if accept else stream(
-        "stats", {"topics": topics, "wait": wait, "stamps": stamps}, use_daemon=not args.no_daemon)
+    content_filter = content_filter_options(args)
+    events = _filtered(args, topics[0], accept, wait, content_filter) if accept else stream(
+        "stats", {"topics": topics, "wait": wait, "stamps": stamps, "content_filter": content_filter},
+        use_daemon=not args.no_daemon)
     reported_lost = dict.fromkeys(topics, 0)
     for event in events:
         kind = event["event"]
         if kind == "not_published":
             print_text(f"WARNING: topic [{event['topic']}] does not appear to be published yet\n")
-        elif kind == "subscribed" and subscribed is not None and args.format != "json":
-            print_lines_of(subscribed(event["topic"]))
+        elif kind == "subscribed":
+            note_content_filter(event["topic"], event)
+            if subscribed is not None and args.format != "json":
+                print_lines_of(subscribed(event["topic"]))
         elif kind == "batch":
             results = {}
             for topic, columns in event["topics"].items():
@@ -69,7 +75,7 @@ def print_lines_of(lines: list[str]) -> None:
     print_text("".join(f"{line}\n" for line in lines))
 
 
-def _filtered(args: argparse.Namespace, topic: str, accept, wait: float):
+def _filtered(args: argparse.Namespace, topic: str, accept, wait: float, content_filter: dict | None):
     """``batch`` events from the ``echo`` stream, with only the messages ``accept`` takes. Without their
     sequence numbers: the messages left out are not lost, and the rate is of those that pass (counted
     over their source timestamps), not the publisher's."""
@@ -80,12 +86,13 @@ def _filtered(args: argparse.Namespace, topic: str, accept, wait: float):
     columns = ("sequence", "source", "received", "size", "stamp")
     batch: dict[str, list] = {column: [] for column in columns}
     type_name, due = "", time.monotonic() + 1.0
-    for event in stream("echo", {"topic": topic, "wait": wait}, use_daemon=not args.no_daemon):
+    for event in stream("echo", {"topic": topic, "wait": wait, "content_filter": content_filter},
+                        use_daemon=not args.no_daemon):
         if event["event"] == "not_published":
             yield {"event": "not_published", "topic": topic}
         elif event["event"] == "subscribed":
             type_name = event["type"]
-            yield {"event": "subscribed", "topic": topic, "type": type_name}
+            yield {**event, "topic": topic}
         elif event["event"] == "messages":
             for message in event["messages"]:
                 if accept(decode(type_name, message["data"])):  # "subscribed" came first

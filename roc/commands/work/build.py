@@ -52,6 +52,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     remote.add_argument("--remote-cache-timeout", type=float, metavar="SECONDS",
                         help="give up on a server that does not answer within this time, and build "
                              "locally (default: 10)")
+    from roc.cluster.settings import add_cluster_argument
+
+    add_cluster_argument(remote, "build the packages the remote cache misses")
     remote.add_argument("--compiler-cache", choices=("ccache", "sccache", "none"),
                         help="compile CMake packages through ccache or sccache (on the remote cache's server "
                              "too, when one is set)")
@@ -135,9 +138,9 @@ def warn_about_missing_dependencies(workspace) -> None:
         warn(f"'{name}', a dependency of {', '.join(users)}, is in neither the workspace nor an underlay; {hint}")
 
 
-def _remote_cache(args: argparse.Namespace, workspace, options):
+def remote_cache(args: argparse.Namespace, workspace, options):
     """The run's RemoteCache, or None when the remote cache is off or not configured. The environment
-    wins over roc.toml; the command line over both."""
+    wins over roc.toml; the command line over both. (``roc work test`` has only ``--remote-cache``.)"""
     if not (args.remote_cache or os.environ.get("ROC_REMOTE_CACHE")):
         return None  # (nothing of the remote cache imported: a no-op build stays fast)
     from roc.remote_cache.settings import MODE_VARIABLE, URL_VARIABLE, remote_settings
@@ -146,8 +149,9 @@ def _remote_cache(args: argparse.Namespace, workspace, options):
     given = {}
     for dest, variable in (("remote_cache", URL_VARIABLE), ("remote_cache_mode", MODE_VARIABLE)):
         from_file = config is not None and config.from_configuration(args, dest)
-        given[dest] = None if from_file and os.environ.get(variable) else getattr(args, dest)
-    settings = remote_settings(given["remote_cache"], given["remote_cache_mode"], args.remote_cache_timeout)
+        given[dest] = None if from_file and os.environ.get(variable) else getattr(args, dest, None)
+    settings = remote_settings(given["remote_cache"], given["remote_cache_mode"],
+                               getattr(args, "remote_cache_timeout", None))
     if settings is None:
         return None
     if settings.url.startswith("s3://"):
@@ -238,7 +242,10 @@ def _prepare(args: argparse.Namespace):
         force=args.force,
         use_state=not args.no_cache,
     )
-    remote = _remote_cache(args, workspace, options)  # bad settings: a usage error before anything is written
+    remote = remote_cache(args, workspace, options)  # bad settings: a usage error before anything is written
+    from roc.cluster.settings import cluster_address
+
+    args.cluster_address = None if args.explain else cluster_address(args, remote)
     return workspace, options, switches, remote
 
 
@@ -246,7 +253,7 @@ def _locked_build(args, workspace, options, switches: dict[str, bool], remote, e
                   stop: threading.Event | None = None) -> int:
     """Build under the build base's lock. ``extra_handlers`` (roc tui's board and summary) replace the
     console; ``stop`` ends the run as Ctrl+C does."""
-    from roc.builder.layout import prepare_build_base, prepare_install_base
+    from roc.builder.layout import prepare_build_base, prepare_distribution, prepare_install_base
     from roc.builder.lock import build_lock
 
     compiler = None
@@ -255,14 +262,36 @@ def _locked_build(args, workspace, options, switches: dict[str, bool], remote, e
 
         compiler = compiler_cache(args.compiler_cache, args.compiler_cache_dir, workspace.root, options.build_base,
                                   remote.settings if remote else None)
-    with build_lock(options.build_base):
-        prepare_build_base(options.build_base)
-        prepare_install_base(options.install_base, args.merge_install)
-        return _build(args, workspace, options, switches, remote, compiler, extra_handlers, stop)
+    cluster = _connect_cluster(args, workspace, options, remote)
+    try:
+        with build_lock(options.build_base):
+            prepare_build_base(options.build_base)
+            prepare_distribution(options.build_base, options.install_base)
+            prepare_install_base(options.install_base, args.merge_install)
+            return _build(args, workspace, options, switches, remote, compiler, extra_handlers, stop, cluster)
+    finally:
+        if cluster is not None:
+            cluster.cluster.close()
+
+
+def _connect_cluster(args, workspace, options, remote):
+    """The run's ClusterBuilds with --cluster, when anything is to be built (a no-op build never loads
+    Dask): the scheduler unreachable or no worker fitting is a one-line error before anything is done."""
+    if not args.cluster_address:
+        return None
+    from roc.builder.uptodate import anything_to_build
+
+    if not anything_to_build(workspace, options):
+        return None
+    from roc.cluster.client import connect
+    from roc.cluster.remote_build import ClusterBuilds
+
+    compiler = None if args.compiler_cache == "none" else args.compiler_cache
+    return ClusterBuilds(connect(args.cluster_address, options.install_base), workspace, remote, compiler)
 
 
 def _build(args, workspace, options, switches: dict[str, bool], remote, compiler,
-           extra_handlers: list | None = None, stop: threading.Event | None = None) -> int:
+           extra_handlers: list | None = None, stop: threading.Event | None = None, cluster=None) -> int:
     from roc.builder.layout import refresh_install_scripts
     from roc.builder.plan import plan_build
     from roc.engine.executor import execute
@@ -275,8 +304,9 @@ def _build(args, workspace, options, switches: dict[str, bool], remote, compiler
     handlers = [*output_handlers(args, switches, workspace.root, options.build_base, console=extra_handlers is None),
                 durations, *(extra_handlers or [])]
     try:
-        tasks = plan_build(workspace, options, jobserver, durations.durations, remote, compiler)
-        result = execute(tasks, handlers, workers, continue_on_error=args.continue_on_error, stop=stop)
+        tasks = plan_build(workspace, options, jobserver, durations.durations, remote, compiler, cluster)
+        limit = workers if cluster is None else cluster.cluster.task_limit(workers)
+        result = execute(tasks, handlers, limit, continue_on_error=args.continue_on_error, stop=stop)
     finally:
         jobserver.close()
         statistics = compiler.finish() if compiler is not None else None

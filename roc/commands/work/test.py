@@ -11,7 +11,7 @@ from roc.cli.options import (
     add_base_arguments,
     add_selection_arguments,
 )
-from roc.engine.events import Event, TestFailures
+from roc.engine.events import Event, TestFailures, TestsNotRun
 from roc.errors import EXIT_FAILURE, EXIT_INTERRUPTED, UsageError
 from roc.handlers import add_event_handlers_argument, handler_switches, output_handlers
 
@@ -46,18 +46,37 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add("--output", choices=("text", "json"), default="text", help="json: one JSON event per line on stdout")
     add("--force", action="store_true", help="test the selected packages even when their results are cached")
     add("--no-cache", action="store_true", help="neither reuse passing results nor record them")
+    from roc.cluster.settings import add_cluster_argument
+
+    add_cluster_argument(parser, "run the tests")
+    add("--remote-cache", metavar="URL", help="with --cluster: the remote build cache the workers restore the "
+        "packages from and send the results through (default: $ROC_REMOTE_CACHE)")
     add_selection_arguments(parser)
 
 
-class TestFailureKeys:
-    """Which tasks' tests failed (for ``[ with test failures ]`` and the exit code)."""
+class TestOutcomes:
+    """Which tasks' tests failed (for ``[ with test failures ]`` and the exit code), and which ran none
+    and why (``[ no tests ran: ... ]``)."""
+
+    __test__ = False
 
     def __init__(self) -> None:
         self.keys: set[str] = set()
+        self.not_run: dict[str, str] = {}
 
     def __call__(self, event: Event) -> None:
         if isinstance(event, TestFailures):
             self.keys.add(event.key)
+        elif isinstance(event, TestsNotRun):
+            self.not_run[event.key] = event.reason
+
+    def note(self, key: str) -> str:
+        """What the console adds to the task's ``Finished`` line."""
+        if key in self.keys:
+            return "\t[ with test failures ]"
+        if key not in self.not_run:
+            return ""
+        return f"\t[ no tests ran{': ' + self.not_run[key] if self.not_run[key] else ''} ]"
 
 
 def _options(args: argparse.Namespace, root: Path):
@@ -84,12 +103,7 @@ def _skip_untestable(workspace) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from roc.builder.layout import prepare_build_base, prepare_install_base
-    from roc.builder.lock import build_lock
     from roc.commands.work.build import skip_configured_packages
-    from roc.engine.executor import execute
-    from roc.engine.store import DurationStore
-    from roc.testing.plan import KIND, plan_tests
     from roc.workspace.load import load_workspace
 
     switches = handler_switches(args.event_handlers)
@@ -104,18 +118,57 @@ def run(args: argparse.Namespace) -> int:
     _skip_untestable(workspace)
     options = _options(args, workspace.root)
     workers = 1 if args.executor == "sequential" else args.parallel_workers
+    cluster = _cluster(args, workspace, options)
+    try:
+        return _test(args, workspace, options, switches, workers, cluster)
+    finally:
+        if cluster is not None:
+            cluster.cluster.close()
+
+
+def _cluster(args: argparse.Namespace, workspace, options):
+    """The run's ClusterTests with --cluster (one line when the scheduler cannot be reached or no worker
+    fits, before anything runs), else None."""
+    from roc.cluster.settings import cluster_address
+    from roc.commands.work.build import remote_cache
+
+    remote = remote_cache(args, workspace, options)
+    address = cluster_address(args, remote)
+    if address is None or not _anything_to_test(args, workspace, options):
+        return None  # cached results only: the cluster is not asked (nor Dask loaded)
+    from roc.cluster.client import connect
+    from roc.cluster.remote_test import ClusterTests
+
+    return ClusterTests(connect(address, options.install_base), workspace, remote)
+
+
+def _anything_to_test(args: argparse.Namespace, workspace, options) -> bool:
+    from roc.testing.plan import plan_tests
+
+    return any(task.check is None or task.check()
+               for task in plan_tests(workspace, options, {}, force=args.force, use_cache=not args.no_cache))
+
+
+def _test(args: argparse.Namespace, workspace, options, switches: dict[str, bool], workers: int, cluster) -> int:
+    from roc.builder.layout import prepare_build_base, prepare_install_base
+    from roc.builder.lock import build_lock
+    from roc.engine.executor import execute
+    from roc.engine.store import DurationStore
+    from roc.testing.plan import KIND, plan_tests
+
     with build_lock(options.build_base):
         prepare_build_base(options.build_base)
         prepare_install_base(options.install_base, args.merge_install)
         durations = DurationStore(options.build_base / DURATIONS_FILE)
-        failures = TestFailureKeys()
+        failures = TestOutcomes()
         handlers = [*output_handlers(args, switches, workspace.root, options.build_base, verb="test",
-                                     cached_label=CACHED_LABEL, finished_note=lambda key: (
-                                         "\t[ with test failures ]" if key in failures.keys else "")),
+                                     cached_label=CACHED_LABEL, finished_note=failures.note),
                     failures, durations]
         try:
-            tasks = plan_tests(workspace, options, durations.durations, force=args.force, use_cache=not args.no_cache)
-            result = execute(tasks, handlers, workers, continue_on_error=not args.abort_on_error, kind=KIND)
+            tasks = plan_tests(workspace, options, durations.durations, force=args.force, use_cache=not args.no_cache,
+                               runner=cluster)
+            limit = workers if cluster is None else cluster.cluster.task_limit(workers)
+            result = execute(tasks, handlers, limit, continue_on_error=not args.abort_on_error, kind=KIND)
         finally:
             for handler in handlers:
                 getattr(handler, "close", lambda: None)()

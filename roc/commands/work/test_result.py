@@ -43,13 +43,14 @@ def run(args: argparse.Namespace) -> int:
     if args.format == "json":
         print_json({"results": [result.as_dict() for result in (results if args.all else shown)],
                     "summary": {key: value for key, value in summary.as_dict().items()
-                                if key not in ("path", "details")}})
+                                if key not in ("path", "details", "not_started")}})
     elif args.result_files_only:
         print_lines(result.path for result in shown)
     else:
         lines = []
         for result in shown:
             lines.append(result.line())
+            lines += [f"  {reason}" for reason in result.not_started]  # which tests never started, and why
             if args.verbose:
                 for detail in result.details:
                     lines += [f"{'-' if i == 0 else ' '} {line}" for i, line in enumerate(detail.splitlines())]

@@ -1,0 +1,178 @@
+"""The client's side of a cluster run: the connection to the Dask scheduler, how many packages its
+fitting workers take at once, and one package's work as a Dask task, waited for in an engine task's
+thread and cancelled with it.
+
+Dask does the distributing: the task asks for one ``roc-build`` unit and the client's toolchain
+resource, so only a worker with the client's toolchain gets it; a worker that dies while building is
+replaced by another (Dask reschedules the task, up to its ``allowed-failures``); two clients needing
+the same package share one task, named by the package's remote key.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from roc.cluster.spec import PackageWork, WorkResult
+from roc.cluster.toolchain import BUILD_RESOURCE, RESOURCE_PREFIX, resource_name
+from roc.engine.process import TaskCancelled, TaskContext, TaskError
+from roc.errors import RocError
+
+POLL_SECONDS = 0.25
+CAPACITY_SECONDS = 1.0  # how long the workers' count is taken as still true
+
+
+def _quiet_dask_logging() -> None:
+    """Dask's own log lines (a lost connection, a retry) would break roc's console: roc says what
+    matters in its own words."""
+    for name in [n for n in logging.root.manager.loggerDict if n.split(".")[0] in ("distributed", "dask")]:
+        logging.getLogger(name).setLevel(logging.CRITICAL)
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
+
+
+def connect(address: str, install_base: Path) -> Cluster:
+    """Connect to the scheduler and check that a worker fits this workspace's toolchain: a RocError
+    (one line) before anything is built; a note on stderr when the cluster has no worker yet."""
+    import importlib.util
+
+    from roc.cluster.toolchain import client_fingerprint
+    from roc.errors import UsageError
+    from roc.messages import warn
+
+    if importlib.util.find_spec("distributed") is None:
+        raise UsageError("--cluster needs Dask's distributed: pip install 'roc[cluster]' (or distributed) into "
+                         "roc's environment")
+    digest, parts = client_fingerprint(install_base)
+    cluster = Cluster(address, digest, parts)
+    try:
+        note = cluster.check_fits()
+    except BaseException:
+        cluster.close()
+        raise
+    if note:
+        warn(note)
+    return cluster
+
+
+class Cluster:
+    """One run's connection to a scheduler, for a client with toolchain fingerprint ``toolchain`` (made of
+    ``toolchain_parts``)."""
+
+    def __init__(self, address: str, toolchain: str, toolchain_parts: dict | None = None):
+        import distributed
+
+        _quiet_dask_logging()
+        self.address, self.toolchain, self.toolchain_parts = address, toolchain, toolchain_parts or {}
+        security = distributed.security.Security()  # Dask's own settings (its configuration files, DASK_* variables)
+        if address.startswith("tls://") and not (getattr(security, "tls_ca_file", None)
+                                                    and getattr(security, "tls_client_cert", None)):
+            raise RocError(f"cannot reach the Dask scheduler at {address}: tls:// needs Dask's TLS settings for "
+                           "a client (distributed.comm.tls.ca-file, client.cert and client.key, e.g. "
+                           "$DASK_DISTRIBUTED__COMM__TLS__CA_FILE; see docs/cluster.md)")
+        try:
+            self.client = distributed.Client(address, set_as_default=False, security=security)
+        except (OSError, TimeoutError, ValueError, TypeError) as error:
+            reason = str(error).splitlines()[0] if str(error) else type(error).__name__
+            raise RocError(f"cannot reach the Dask scheduler at {address}: {reason}") from None
+        _quiet_dask_logging()
+        self._capacity, self._asked = 0, 0.0
+        self.lost = False
+
+    def close(self) -> None:
+        try:
+            self.client.close(timeout=5)
+        except Exception:  # noqa: BLE001 - the scheduler may be gone already; nothing to keep
+            pass
+
+    def workers(self) -> dict[str, dict]:
+        """The scheduler's workers (address -> its information)."""
+        try:
+            return dict(self.client.scheduler_info()["workers"])
+        except (OSError, TimeoutError) as error:
+            self.lost = True
+            raise RocError(f"lost the Dask scheduler at {self.address}: {error}") from None
+
+    def fitting(self) -> dict[str, float]:
+        """The workers with this client's toolchain: name -> the packages it builds at once."""
+        wanted = resource_name(self.toolchain)
+        return {str(info.get("name", address)): float(info.get("resources", {}).get(BUILD_RESOURCE, 0))
+                for address, info in self.workers().items() if info.get("resources", {}).get(wanted)}
+
+    def check_fits(self) -> str | None:
+        """A RocError when the cluster has workers and none has this toolchain; a note when it has no
+        worker yet (tasks then wait for one), else None."""
+        workers = self.workers()
+        if not workers:
+            return f"the cluster at {self.address} has no worker yet: its tasks wait for one"
+        if self.fitting():
+            return None
+        theirs: dict[str, list[str]] = {}
+        for address, info in workers.items():
+            found = [r.removeprefix(RESOURCE_PREFIX) for r in info.get("resources", {})
+                     if r.startswith(RESOURCE_PREFIX)]
+            theirs.setdefault(found[0] if found else "not a roc worker", []).append(str(info.get("name", address)))
+        listed = "; ".join(f"{digest}: {', '.join(sorted(names))}" for digest, names in sorted(theirs.items()))
+        raise RocError(f"no worker of the cluster at {self.address} has this toolchain ({self.toolchain}); "
+                       f"its workers have {listed} (start workers with the same compilers, build variables and "
+                       "underlays: see docs/cluster.md)")
+
+    def capacity(self) -> int:
+        """How many packages the fitting workers build at once (asked at most once a second)."""
+        now = time.monotonic()
+        if now - self._asked >= CAPACITY_SECONDS and not self.lost:
+            self._asked = now
+            try:
+                self._capacity = int(sum(self.fitting().values()))
+            except RocError:
+                pass  # the tasks that wait say so
+        return self._capacity
+
+    def task_limit(self, local: int) -> int | Callable[[], int]:
+        """The engine's limit of tasks at once (roc.engine.executor.execute's ``workers``): twice what the
+        fitting workers build at once, so that each has its next package waiting while a result travels,
+        and at least ``local`` (--parallel-workers; 0: no limit). The rest stays in roc's ready queue,
+        and what waits on a worker waits in roc's order (each task's priority is the engine's)."""
+        return local if not local else lambda: max(local, 2 * self.capacity())
+
+    def run(self, function: Callable[[PackageWork], WorkResult], work: PackageWork, key: str,
+            context: TaskContext) -> WorkResult:
+        """Run ``function(work)`` as the Dask task ``key`` and wait for its result; Ctrl+C or another
+        task's failure (``context`` cancelled) cancels it."""
+        from concurrent.futures import CancelledError
+        from concurrent.futures import TimeoutError as FutureTimeout
+
+        resources = {BUILD_RESOURCE: 1, resource_name(self.toolchain): 1}
+        future = self.client.submit(function, work, key=key, resources=resources, pure=False,
+                                    priority=context.priority)
+        while True:
+            try:
+                result = future.result(timeout=POLL_SECONDS)
+            except FutureTimeout:
+                if context.cancelled:
+                    self.client.cancel([future])
+                    raise TaskCancelled from None
+                if self.client.status not in ("running", "connecting"):
+                    self.lost = True
+                    raise TaskError(f"lost the Dask scheduler at {self.address}") from None
+                continue
+            except CancelledError:
+                if context.cancelled:
+                    raise TaskCancelled from None
+                self.lost = True
+                raise TaskError(f"lost the Dask scheduler at {self.address}") from None
+            except Exception as error:  # noqa: BLE001 - Dask's errors: KilledWorker, a lost connection
+                raise TaskError(_dask_failure(error)) from None
+            if not isinstance(result, WorkResult):
+                raise TaskError(f"the cluster's task returned {type(result).__name__}, not a roc result: "
+                                "do the workers run this version of roc?")
+            return result
+
+
+def _dask_failure(error: Exception) -> str:
+    name = type(error).__name__
+    if name == "KilledWorker":
+        return "every worker that took it died (Dask gave up after its allowed failures)"
+    text = str(error).splitlines()[0] if str(error) else ""
+    return f"the cluster failed it: {name}{': ' + text if text else ''}"
