@@ -51,17 +51,47 @@ def table(app, selector: str) -> ListTable:
 
 
 async def open_row(app, pilot, tab: str, name: str) -> None:
-    """Filter the list of ``tab`` down to ``name`` and press Enter on it."""
+    """Filter the list of ``tab`` down to ``name`` and press Enter on it. Each key waits for what the one
+    before did (the pilot's keys do not wait on a loaded machine): typed before the filter had the focus,
+    the name's letters were the list's keys (``p`` next problem, ``f`` tf frames, ``c``)."""
+    from textual.widgets import Input
+
     keys = {"nodes": "1", "topics": "2", "services": "3", "actions": "4"}
     await pilot.press(keys[tab])
-    await until(pilot, lambda: name in table(app, f"#{tab}-table").rows_by_key, what=name)
-    await pilot.press("slash", *name, "enter")
     rows = table(app, f"#{tab}-table")
+    await until(pilot, lambda: name in rows.rows_by_key and app.focused is rows, what=f"{name} in the {tab}")
+    await pilot.press("slash")
+    box = app.screen.query_one("#filter", Input)
+    await until(pilot, lambda: app.focused is box, what="the filter's input")
+    await pilot.press(*name)
     try:
-        await until(pilot, lambda: rows.selected_key() == name, what=f"{name} alone")
+        await until(pilot, lambda: rows.filter == name and rows.selected_key() == name, what=f"{name} alone")
     except AssertionError as error:
         raise AssertionError(f"{error} (focused: {app.focused}); the screen:\n" + "\n".join(screen_lines(app))) from None
+    await pilot.press("enter")  # the filter kept, the list focused
+    await until(pilot, lambda: app.focused is rows, what="the filtered list")
     await pilot.press("enter")
+
+
+async def palette_command(app, pilot, command: str, entry: str | None = None) -> None:
+    """Type ``command`` into the command palette (``:``) and run its ``entry`` (the command itself
+    unless given) once the palette highlights it."""
+    from textual.command import CommandInput, CommandList, CommandPalette
+
+    await pilot.press("colon")
+    await until(pilot, lambda: isinstance(app.screen, CommandPalette) and isinstance(app.focused, CommandInput),
+                what="the command palette")
+    await pilot.press(*command)
+    palette, entry = app.screen, entry or command
+
+    def highlighted() -> str:
+        found = palette.query_one(CommandList)
+        if found.highlighted is None or palette.query_one(CommandInput).value != command:
+            return ""
+        return str(found.get_option_at_index(found.highlighted).hit.text)
+    await until(pilot, lambda: highlighted() == entry, what=f"the palette's entry {entry!r}")
+    await pilot.press("enter")
+    await until(pilot, lambda: app.screen is not palette, what=f"{entry} run")
 
 
 CMAKE = "cmake_minimum_required(VERSION 3.10)\nproject({name} NONE)\n{extra}"
