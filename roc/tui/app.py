@@ -122,6 +122,12 @@ class RocApp(App[int]):
             from roc.tui.launch_screen import LaunchScreen
 
             return LaunchScreen()
+        if kind == "image":
+            from roc.tui.image_screen import ImageScreen
+
+            if not name:
+                raise UsageError("image TOPIC: e.g. image /camera/image_raw")
+            return ImageScreen(name, self.type_of("topic", name))
         raise UsageError(f"no view '{kind}'")
 
     def type_of(self, kind: str, name: str) -> str:

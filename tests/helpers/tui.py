@@ -59,6 +59,9 @@ async def open_row(app, pilot, tab: str, name: str) -> None:
     keys = {"nodes": "1", "topics": "2", "services": "3", "actions": "4"}
     await pilot.press(keys[tab])
     rows = table(app, f"#{tab}-table")
+    if rows.filter:  # one kept from before
+        await until(pilot, lambda: app.focused is rows, what=f"the {tab}")
+        await pilot.press("escape")
     await until(pilot, lambda: name in rows.rows_by_key and app.focused is rows, what=f"{name} in the {tab}")
     await pilot.press("slash")
     box = app.screen.query_one("#filter", Input)
