@@ -114,9 +114,10 @@ def test_an_image_topic_drawn_live_paused_and_a_compressed_one_from_the_palette(
             await open_row(app, pilot, "topics", "/camera/image_raw")
             await until(pilot, lambda: screen_name(app) == "TopicScreen" and app.screen.type_name == IMAGE,
                         what="the topic and its type")
+            started = time.monotonic()  # before the screen's stream starts
             await pilot.press("i")
             await until(pilot, lambda: screen_name(app) == "ImageScreen", what="the image screen")
-            screen, started = app.screen, time.monotonic()
+            screen = app.screen
             await until(pilot, lambda: screen.frames >= 3, what="three frames")
             assert drawn_colours(app) == {(RED, RED), (BLUE, BLUE)}
             assert "4x2 rgb8" in str(screen.query_one("#title").render())
