@@ -12,27 +12,30 @@ in bursts. Latency benchmarks leave it off: the stamp is taken as each message i
 send does not skew it, while a publisher that outranks every other process makes the processes it
 measures wait for a core (through roc bridge's Zenoh link, 0.4 to 0.6 ms more added median at 5 kHz).
 
-    python bench/paced_publisher.py TOPIC RATE SECONDS WAIT [stamped] [steady]
+``sine``: std_msgs/Float64 messages instead, a sine of 0.5 Hz (for a plot, tui_bench.py).
+
+    python bench/paced_publisher.py TOPIC RATE SECONDS WAIT [stamped] [steady] [sine]
 """
 
 from __future__ import annotations
 
 import collections
 import json
+import math
 import os
 import sys
 import time
 
 import rclpy
 from rclpy.qos import QoSProfile
-from std_msgs.msg import String
+from std_msgs.msg import Float64, String
 
 HZ_WINDOW = 10000  # roc's and ros2's topic hz measure over the last 10000 messages by default
 
 
 def main() -> None:
     topic, rate, seconds, wait = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
-    stamped, steady = "stamped" in sys.argv[5:], "steady" in sys.argv[5:]
+    stamped, steady, sine = "stamped" in sys.argv[5:], "steady" in sys.argv[5:], "sine" in sys.argv[5:]
     if steady:
         try:
             os.nice(-5)
@@ -41,8 +44,8 @@ def main() -> None:
                   file=sys.stderr)
     rclpy.init()
     node = rclpy.create_node("paced_publisher")
-    publisher = node.create_publisher(String, topic, QoSProfile(depth=1000))
-    message = String(data="x" * 64)
+    publisher = node.create_publisher(Float64 if sine else String, topic, QoSProfile(depth=1000))
+    message = Float64() if sine else String(data="x" * 64)
     time.sleep(wait)
     period, count = 1.0 / rate, 0
     sent = collections.deque(maxlen=HZ_WINDOW)
@@ -53,6 +56,8 @@ def main() -> None:
             time.sleep(due - now)
         if stamped:
             message.data = str(time.time_ns())
+        elif sine:
+            message.data = math.sin(math.pi * count / rate)
         publisher.publish(message)
         sent.append(time.perf_counter())
         count += 1

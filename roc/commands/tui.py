@@ -15,17 +15,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from roc.tui.app import RocApp, require_terminal
+    from roc.tui import require_terminal
+    from roc.tui.feed import Feed
 
     require_terminal("roc tui")
+    feed = Feed()
+    feed.prefetch()  # answered while the rest loads
     from roc.commands.work.build import build_runner
+    from roc.tui.app import RocApp
     from roc.tui.packages import WorkspaceView
     from roc.tui.problems import find_expectations
     from roc.workspace.root import find_workspace_root
 
     root = None if args.no_workspace else find_workspace_root(Path.cwd())
     workspace = WorkspaceView(root) if root is not None and (root / "src").is_dir() else None
-    app = RocApp(workspace=workspace, new_build=build_runner, checks=find_expectations(Path.cwd()),
+    app = RocApp(feed=feed, workspace=workspace, new_build=build_runner, checks=find_expectations(Path.cwd()),
                  bag=args.bag)
     try:
         return app.run() or 0

@@ -59,6 +59,7 @@ class Monitor:
     rows: dict[str, ProcessRow] = field(default_factory=dict)
     stopping: threading.Event = field(default_factory=threading.Event)  # set: the run is ending, exits are stops
     last_start: float = 0.0  # time.monotonic() of the last process start
+    stop_asked: set[str] = field(default_factory=set)  # processes stopped on request (roc tui): an exit is a stop
 
     def __post_init__(self) -> None:
         self._lock = threading.Lock()
@@ -103,6 +104,7 @@ class Monitor:
             row = self._row(name)
             row.pid, row.state, row.detail, row.code, row.cpu, row.rss = pid, "running", "", None, None, None
             row.starts += 1
+            self.stop_asked.discard(name)
             row.started_at = self.last_start = time.monotonic()
             if self.logs:
                 how = " (warm start)" if warm else ""
@@ -133,7 +135,9 @@ class Monitor:
         with self._lock:
             row = self._row(name)
             row.code = code
-            if code == 0:
+            if name in self.stop_asked:
+                row.state, row.detail = "stopped", f"exit code {code}"
+            elif code == 0:
                 row.state, row.detail = "exited", "exit code 0"
             elif self.stopping.is_set():
                 row.state, row.detail = "stopped", f"exit code {code}"

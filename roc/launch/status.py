@@ -1,9 +1,10 @@
 """A running ``roc launch``'s status and control, for ``roc tui``: a private Unix socket per run in
 roc's runtime directory (``launch-<pid>.sock``, mode 0600), JSON lines in and out, one request a line:
 
-- ``{"method": "status"}`` -> ``{"title", "pid", "log_directory", "processes": [{name, host, pid, state,
-  detail, restarts, last_line, code}]}`` (host: the SSH destination of a process on another host, its pid
-  that of its ssh client here);
+- ``{"method": "status"}`` -> ``{"title", "pid", "log_directory", "restartable", "processes": [{name, host,
+  pid, state, detail, restarts, last_line, code}]}`` (``restartable``: its processes can be started again, a
+  roc.toml system's; a launch file's cannot; ``host``: the SSH destination of a process on another host, its
+  pid that of its ssh client here);
 - ``{"method": "stop", "process": NAME}``, ``{"method": "restart", "process": NAME}`` -> ``{"ok": true}`` or
   ``{"error": MESSAGE}``.
 
@@ -36,6 +37,8 @@ def socket_directory() -> Path:
 
 
 class Control(Protocol):
+    restartable: bool
+
     def stop(self, process: str) -> None: ...
 
     def restart(self, process: str) -> None: ...
@@ -43,7 +46,10 @@ class Control(Protocol):
 
 class SupervisorControl:
     """Stop or restart one process of a roc.toml system (roc/launch/supervisor.py): stopped as the
-    whole run stops its processes (SIGINT, SIGTERM, SIGKILL); restarted once its watcher has ended."""
+    whole run stops its processes (SIGINT, SIGTERM, SIGKILL), on purpose (no respawn, no failure of the
+    run); restarted once its watcher has ended."""
+
+    restartable = True
 
     def __init__(self, supervisor, system) -> None:
         self.supervisor = supervisor
@@ -57,7 +63,9 @@ class SupervisorControl:
         return process
 
     def stop(self, process: str) -> None:
-        self.supervisor._stop_one(process, self._process(process))
+        running = self._process(process)
+        self.supervisor.monitor.stop_asked.add(process)
+        self.supervisor._stop_one(process, running)
 
     def restart(self, process: str) -> None:
         if process not in self.specs:
@@ -70,8 +78,11 @@ class SupervisorControl:
 
 
 class SignalControl:
-    """Stop one process the launch library started (SIGINT to its process, as the library stops it);
-    the library cannot start one again on request."""
+    """Stop one process the launch library started (SIGINT to its process, as the library stops it; its
+    exit is a stop, as ros2 launch's run goes on when a process is stopped from outside); the library
+    cannot start one again on request."""
+
+    restartable = False
 
     def __init__(self, monitor) -> None:
         self.monitor = monitor
@@ -80,6 +91,7 @@ class SignalControl:
         row = next((r for r in self.monitor.snapshot() if r.name == process and r.state == "running"), None)
         if row is None or row.pid is None:
             raise RocError(f"{process} is not running")
+        self.monitor.stop_asked.add(process)
         os.kill(row.pid, 2)
 
     def restart(self, process: str) -> None:
@@ -131,6 +143,7 @@ class StatusServer:
             monitor = self.running.monitor
             return {"title": self.running.options.title, "pid": os.getpid(),
                     "log_directory": str(self.running.log_directory) if self.running.log_directory else None,
+                    "restartable": self.control.restartable,
                     "processes": [{"name": r.name, "host": r.host or None, "pid": r.pid, "state": r.state,
                                    "detail": r.detail,
                                    "restarts": r.restarts, "last_line": r.last_line, "code": r.code}

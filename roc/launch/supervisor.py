@@ -106,7 +106,8 @@ class Supervisor:
             process.stdout.close()
             code = process.wait()
             self.monitor.exited(spec.label, process.pid, code, _command_line(process))
-            if not spec.respawn or self.stopping.is_set() or self.stopping.wait(spec.respawn_delay):
+            asked = spec.label in self.monitor.stop_asked  # stopped on request: no respawn, no failure
+            if not spec.respawn or asked or self.stopping.is_set() or self.stopping.wait(spec.respawn_delay):
                 break
             try:
                 process = self._spawn(spec)
@@ -115,7 +116,7 @@ class Supervisor:
                 break
         with self._lock:
             self._running.pop(spec.label, None)
-            if code != 0 and not self.stopping.is_set():
+            if code != 0 and not self.stopping.is_set() and spec.label not in self.monitor.stop_asked:
                 self.failed.append(spec.label)
             self._changed.notify_all()
 

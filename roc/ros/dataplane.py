@@ -149,7 +149,8 @@ def echo(graph, params: dict[str, Any]) -> Events:
     arrays cut after ``truncate_length`` elements: for a client that loads no rclpy), ``content_filter``
     (``{expression, parameters, middleware}``: only the messages that pass, filtered by the middleware
     where it can, else here; ``subscribed`` then says which, and no message counts as lost, since the
-    ones filtered out leave gaps in the sequence numbers)."""
+    ones filtered out leave gaps in the sequence numbers), ``latest_every`` (seconds: only the newest message,
+    in at most one event this often, for an image preview; the ones left out are not lost)."""
     topic, timeout = params["topic"], params.get("timeout")
     started = time.monotonic()
     if timeout is not None:
@@ -164,10 +165,21 @@ def echo(graph, params: dict[str, Any]) -> Events:
         yield {"event": "subscribed", "type": type_name, **({"content_filter": filtering} if filtering else {})}
         last_sequence: dict[str, int] = {}  # by publisher gid
         deadline = started + timeout if timeout is not None else None
+        latest_every, sent = params.get("latest_every"), 0.0  # sent: time.monotonic() of the last event
+
+        def received(seconds: float) -> list:
+            batch = receiver.batch(seconds, MAX_BATCH)
+            return [item for item in batch if local.accepts(deserialize_message(item[1], cls))] if local else batch
+
+        def lost(info: dict[str, Any]) -> int:
+            """The messages of info's publisher that never arrived since its last one (info loses its gid)."""
+            sequence, gid = info["publication_sequence_number"], info.pop("gid")
+            if wanted is not None:
+                return 0  # the messages filtered out are not lost
+            previous, last_sequence[gid] = last_sequence.get(gid), sequence
+            return max(sequence - previous - 1, 0) if sequence is not None and previous is not None else 0
         while True:
-            batch = receiver.batch(HEARTBEAT_SECONDS, MAX_BATCH)
-            if local is not None:
-                batch = [item for item in batch if local.accepts(deserialize_message(item[1], cls))]
+            batch = received(HEARTBEAT_SECONDS)
             if not batch:
                 if deadline is not None and time.monotonic() >= deadline:
                     yield {"event": "timeout"}
@@ -175,17 +187,18 @@ def echo(graph, params: dict[str, Any]) -> Events:
                 yield {"event": "heartbeat"}
                 continue
             deadline = None  # a message arrived: the timeout is over
-            messages = []
-            for _, data, info in batch:
-                sequence, gid = info["publication_sequence_number"], info.pop("gid")
-                if wanted is not None:
-                    sequence = None  # the messages filtered out are not lost
-                previous = last_sequence.get(gid)
-                lost = sequence - previous - 1 if sequence is not None and previous is not None else 0
-                if sequence is not None:
-                    last_sequence[gid] = sequence
-                messages.append({"data": base64.b64encode(data).decode(), "lost": max(lost, 0),
-                                 "info": {key: value for key, value in info.items() if value is not None}})
+            carried = 0  # lost before the messages left out for ``latest_every``
+            if latest_every:  # until it is due, newer messages replace the ones kept
+                while (remaining := sent + latest_every - time.monotonic()) > 0:
+                    if newer := received(remaining):
+                        carried += sum(lost(info) for _, _, info in batch)
+                        batch = newer
+                carried += sum(lost(info) for _, _, info in batch[:-1])
+                batch, sent = batch[-1:], time.monotonic()
+            messages: list[dict[str, Any]] = [
+                {"data": base64.b64encode(data).decode(), "lost": lost(info),
+                 "info": {key: value for key, value in info.items() if value is not None}} for _, data, info in batch]
+            messages[0]["lost"] += carried
             if params.get("latest_value"):
                 messages[-1]["value"] = value_to_data(deserialize_message(batch[-1][1], cls),
                                                       truncate_length=params.get("truncate_length"))

@@ -84,7 +84,9 @@ def values(graph, params: dict[str, Any]) -> Events:
     heartbeats, for the topic to appear), then per batch of messages either ``values {messages: [{value,
     time, publisher}]}`` (each message as plain data; ``truncate_length`` cuts strings and arrays) or,
     with ``fields`` (dotted paths to numbers), ``samples {time: [...], values: {path: [...]}, lost}``
-    (``time``: the publication's source timestamp in ns; a field a message lacks is null)."""
+    (``time``: the publication's source timestamp in ns; a field a message lacks is null). With ``period``
+    (seconds), a batch waits that long for more messages: a plot of a 1 kHz topic gets 20 events a
+    second instead of hundreds."""
     topic = params["topic"]
     cls, type_name, found = yield from _topic_class(graph, topic, {"wait": params.get("wait", 0.0)},
                                                     wait_for_type=True)
@@ -100,6 +102,9 @@ def values(graph, params: dict[str, Any]) -> Events:
             if not batch:
                 yield {"event": "heartbeat"}
                 continue
+            due = time.monotonic() + params.get("period", 0.0)
+            while len(batch) < MAX_BATCH and (remaining := due - time.monotonic()) > 0:
+                batch += receiver.batch(remaining, MAX_BATCH - len(batch))
             lost, times, decoded = 0, [], []
             for _, data, info in batch:
                 sequence, gid = info.get("publication_sequence_number"), info.get("gid", "")

@@ -5,3 +5,13 @@ the graph (graph_screen), a node (node_screen), a topic (topic_screen), a servic
 (call_screens), the tf tree (frames_screen), a live build (build_screen, fed by
 roc.handlers.board). ``model`` holds what they show as plain data.
 """
+
+import sys
+
+from roc.errors import UsageError
+
+
+def require_terminal(what: str) -> None:
+    """A usage error unless roc runs in a terminal (checked before Textual loads)."""
+    if not (sys.stdin.isatty() and sys.stdout.isatty()):
+        raise UsageError(f"{what} needs a terminal (stdin and stdout are not both one)")

@@ -5,7 +5,6 @@ while the TUI shows it."""
 from __future__ import annotations
 
 import os
-import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
@@ -123,6 +122,12 @@ class RocApp(App[int]):
             from roc.tui.launch_screen import LaunchScreen
 
             return LaunchScreen()
+        if kind == "image":
+            from roc.tui.image_screen import ImageScreen
+
+            if not name:
+                raise UsageError("image TOPIC: e.g. image /camera/image_raw")
+            return ImageScreen(name, self.type_of("topic", name))
         raise UsageError(f"no view '{kind}'")
 
     def type_of(self, kind: str, name: str) -> str:
@@ -174,11 +179,6 @@ class RocApp(App[int]):
         import asyncio
 
         await asyncio.get_running_loop().run_in_executor(None, function)
-
-
-def require_terminal(what: str) -> None:
-    if not (sys.stdin.isatty() and sys.stdout.isatty()):
-        raise UsageError(f"{what} needs a terminal (stdin and stdout are not both one)")
 
 
 def run_build_app(start: Start, verb: str = "build") -> int:

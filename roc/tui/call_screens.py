@@ -223,9 +223,13 @@ class PublishScreen(CallScreen):
         worker = get_current_worker()
         params = {"topic": self.target, "type": self.type_name, "value": value, "times": 1 if rate is None else 0,
                   "rate": rate, "keep_alive": 0.5}
+
+        def published(count: int) -> None:  # on the app's thread: a Ctrl+T before it has the last word
+            if not worker.is_cancelled:
+                self.say(f"published message {count}", count > 1)
         try:
             for event in host(self).feed.stream("publish", params, lambda: worker.is_cancelled):
-                if event["event"] == "published" and not worker.is_cancelled:
-                    self.app.call_from_thread(self.say, f"published message {event['count']}", event["count"] > 1)
+                if event["event"] == "published":
+                    self.app.call_from_thread(published, event["count"])
         except RocError as error:
             self.app.call_from_thread(self.say, f"error: {error}")

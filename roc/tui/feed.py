@@ -10,12 +10,21 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable, Iterator
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from roc.errors import RocError
 from roc.ros.client import DaemonError, Session, start_daemon
 
+if TYPE_CHECKING:
+    from concurrent.futures import Future
+
 CALL_TIMEOUT = 5.0  # seconds for a node's service to answer, as roc's verbs wait
+ENDPOINTS_SECONDS = 5.0
+
+
+def counts_of(snapshot: dict[str, Any]) -> dict[str, tuple[int, int]]:
+    """Each topic's publishers and subscribers, as a snapshot counts them."""
+    return {topic["name"]: (topic["publishers"], topic["subscribers"]) for topic in snapshot["topics"]}
 
 
 class Feed:
@@ -25,6 +34,25 @@ class Feed:
     def __init__(self) -> None:
         self._session: Session | None = None
         self._lock = threading.Lock()
+        self._first: Future | None = None
+        self._endpoints: dict[str, dict[str, Any]] = {}  # topic -> its endpoints, as last asked for
+        self._endpoints_due = 0.0  # time.monotonic() when they are asked for again
+
+    def prefetch(self) -> None:
+        """Ask for the first snapshot now, on a thread of its own: the daemon answers while the app's
+        modules load (about as long as its answer takes), so that the first screen can show the graph."""
+        from concurrent.futures import Future
+
+        first: Future = Future()
+
+        def ask() -> None:
+            try:
+                first.set_result(self.query("snapshot", {"endpoints": True}))
+            except BaseException as error:  # noqa: BLE001 - raised again where the snapshot is taken
+                first.set_exception(error)
+
+        self._first = first
+        threading.Thread(target=ask, name="roc-tui-prefetch", daemon=True).start()
 
     def session(self) -> Session:
         with self._lock:
@@ -36,8 +64,26 @@ class Feed:
         return self.session().query(method, params)
 
     def snapshot(self) -> dict[str, Any]:
-        """Nodes, topics with their endpoints (for the diagnoses), services, actions."""
-        return self.query("snapshot", {"endpoints": True})
+        """Nodes, topics with their endpoints (for the diagnoses and the nodes' processes), services,
+        actions (the first time, the prefetched answer, if any). The endpoints are asked for again when
+        a topic's counts change and every ENDPOINTS_SECONDS, else the last ones are kept: asking for
+        those of 200 topics every second cost the daemon 20 % of a core."""
+        first, self._first = self._first, None
+        if first is not None:
+            return self._full(first.result())
+        if time.monotonic() < self._endpoints_due:
+            found = self.query("snapshot", {"endpoints": False})
+            known = self._endpoints
+            if counts_of(found) == {name: (len(ends["publishers"]), len(ends["subscribers"]))
+                                    for name, ends in known.items()}:
+                return {**found, "topics": [{**topic, "endpoints": known[topic["name"]]} for topic in found["topics"]]}
+        return self._full(self.query("snapshot", {"endpoints": True}))
+
+    def _full(self, snapshot: dict[str, Any]) -> dict[str, Any]:
+        """Keep the endpoints of a snapshot asked for with them."""
+        self._endpoints = {topic["name"]: topic["endpoints"] for topic in snapshot["topics"] if "endpoints" in topic}
+        self._endpoints_due = time.monotonic() + ENDPOINTS_SECONDS
+        return snapshot
 
     def stream(self, method: str, params: dict[str, Any], stop: Callable[[], bool]) -> Iterator[dict[str, Any]]:
         """The events of a daemon stream, heartbeats included, until it ends or ``stop()`` is true
@@ -55,7 +101,6 @@ class Feed:
                     yield response
         finally:
             connection.close()
-
 
     def call(self, service: str, type_name: str, request: dict[str, Any], timeout: float = CALL_TIMEOUT) -> Any:
         """Call a service with a request given as plain data; its response as plain data (the daemon

@@ -39,6 +39,15 @@ SYSTEM = ("nodes", "topics")
 NARROW = 100  # below this many columns, the nodes are above the topics instead of beside them
 
 
+class ListTabs(TabbedContent):
+    """Tabs that change only when asked (a key, a click on a tab), never because a list inside one got the
+    focus: Textual follows the focus a moment later, so a tab chosen just then was switched back."""
+
+    def _on_tab_pane_focused(self, event: TabPane.Focused) -> None:
+        event.prevent_default()
+        event.stop()
+
+
 class GraphScreen(Screen):
     BINDINGS = [
         Binding("slash", "filter", "filter"),
@@ -88,13 +97,15 @@ class GraphScreen(Screen):
         self.snapshot: dict[str, Any] | None = None
         self.measured: list[str] = []  # the topics the rates stream measures
         self.status = "roc tui  connecting to the roc daemon..."
+        self.shown_texts: dict[str, Text] = {}  # selector -> the text shown there
         self.workspace_error = ""
 
     def compose(self) -> ComposeResult:
         yield Static(self.status, id="header")
         yield Static("", id="problems")
-        with TabbedContent(initial="system-tab", id="tabs"):
-            with TabPane("System", id="system-tab"), Container(id="system"):
+        with ListTabs(initial="system-tab", id="tabs"):
+            narrow = "narrow" if self.app.size.width < NARROW else ""  # as on_resize sets it: no restyle then
+            with TabPane("System", id="system-tab"), Container(id="system", classes=narrow):
                 for name in SYSTEM:
                     yield self.list_table(name)
             for name in ("services", "actions"):
@@ -122,6 +133,7 @@ class GraphScreen(Screen):
             self.show_packages()
             self.set_interval(2.0, self.show_packages)
         self.query_one("#topics-table").focus()
+        self.watch(self.table("topics"), "scroll_y", self.show_again, init=False)
 
     # -- data ------------------------------------------------------------------------------------
     @work(thread=True, exclusive=True, group="snapshot")
@@ -136,13 +148,16 @@ class GraphScreen(Screen):
 
     def show_status(self, text: str) -> None:
         self.status = text
-        for header in self.query("#header").results(Static):  # none once the app is closing
-            header.update(Text(text))
+        if self.query("#header"):  # none once the app is closing
+            self.put("#header", Text(text))
 
     def show_snapshot(self, snapshot: dict[str, Any], usage=None) -> None:
         if not self.query("#problems"):  # the app is closing
             return
         self.snapshot = snapshot
+        if self.app.screen is not self:  # under another screen: drawn when it is back (on_screen_resume)
+            self.problem_watch.nodes_gone([n["full_name"] for n in visible(snapshot["nodes"], self.hidden)])
+            return
         number = counts(snapshot, self.hidden)
         self.show_status("roc tui  " + "  ".join(plural(number[kind], kind.rstrip("s"))
                                                  for kind in ("nodes", "topics", "services", "actions")))
@@ -152,26 +167,45 @@ class GraphScreen(Screen):
         self.show_problems()
         gone = self.problem_watch.nodes_gone(nodes)
         self.table("nodes").show(node_rows(snapshot, self.hidden, usage or self.processes.usage, gone))
-        self.table("topics").show(topic_rows(snapshot, self.rates, self.hidden))
+        topics_table = self.table("topics")
+        self.rates.in_view = topics_table.keys_in_view() if topics_table.shown_count else None
+        topics_table.show(topic_rows(snapshot, self.rates, self.hidden))
         self.table("services").show(typed_rows(snapshot["services"], self.hidden))
         self.table("actions").show(typed_rows(snapshot["actions"], self.hidden))
         published = sorted(t["name"] for t in topics if t["publishers"])
         if published != self.measured:
             self.measured = published
             self.rates.keep(set(published))
-            self.measure(published)
+            self.call_after_refresh(self.measure, published)  # once this is on the screen
         self.show_detail()
+
+    def on_screen_resume(self) -> None:
+        self.show_again()
+
+    def show_again(self, *_changed) -> None:
+        """The lists drawn again from the last snapshot: rows that came into view (scrolled, filtered,
+        their tab chosen) get their rates measured now (see Rates.texts)."""
+        if self.snapshot is not None:
+            self.show_snapshot(self.snapshot)
+        else:
+            self.show_detail()
+
+    def put(self, selector: str, text: Text) -> None:
+        """Show ``text`` in a line of the screen, if it changed (a line drawn again costs a layout)."""
+        if self.shown_texts.get(selector) != text:
+            self.shown_texts[selector] = text
+            self.query_one(selector, Static).update(text)
 
     def show_problems(self) -> None:
         """The problems line: how many, the first (or the one ``p`` went to), and the key."""
-        line = self.query_one("#problems", Static)
         if not self.problems:
-            line.update(Text("no problems", style="green"))
+            self.put("#problems", Text("no problems", style="green"))
             return
         index = self.problem_index if 0 <= self.problem_index < len(self.problems) else 0
         severity = "bold red" if any(p.severity == "error" for p in self.problems) else "yellow"
-        line.update(Text.assemble((f"{plural(len(self.problems), 'problem')}", severity),
-                                  f" ({index + 1}/{len(self.problems)}, p: next)  ", self.problems[index].text))
+        self.put("#problems", Text.assemble((f"{plural(len(self.problems), 'problem')}", severity),
+                                            f" ({index + 1}/{len(self.problems)}, p: next)  ",
+                                            self.problems[index].text))
 
     @work(thread=True, exclusive=True, group="rates")
     def measure(self, topics: list[str]) -> None:
@@ -207,7 +241,7 @@ class GraphScreen(Screen):
         if table.filter:
             text = (f"filter '{table.filter}': {table.shown_count} shown (/ changes it, Esc clears it)"
                     + (f"  |  {text}" if text else ""))
-        self.query_one("#detail", Static).update(Text(text))
+        self.put("#detail", Text(text))
 
     def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
         if event.data_table.has_focus:  # a list redrawn in the background is not the one the keys act on
@@ -229,7 +263,7 @@ class GraphScreen(Screen):
         table = self.table(self.active_tab())
         table.focus()
         self.query_one("#filter", Input).value = table.filter
-        self.show_detail()
+        self.show_again()
 
     def on_data_table_row_selected(self, event: DataTable.RowSelected) -> None:
         key = event.row_key.value
@@ -252,7 +286,7 @@ class GraphScreen(Screen):
     def on_input_changed(self, event: Input.Changed) -> None:
         if event.input.id == "filter":
             self.table(self.active_tab()).set_filter(event.value)
-            self.show_detail()
+            self.show_again()
 
     def action_enter(self) -> None:
         focused = self.focused

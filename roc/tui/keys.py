@@ -14,6 +14,7 @@ SCREENS = (
     ("topic", "roc.tui.topic_screen", "TopicScreen"),
     ("logs", "roc.tui.logs_screen", "LogsScreen"),
     ("plot", "roc.tui.plot_screen", "PlotScreen"),
+    ("image", "roc.tui.image_screen", "ImageScreen"),
     ("diagnostics", "roc.tui.diagnostics_screen", "DiagnosticsScreen"),
     ("service, action", "roc.tui.call_screens", "ActionScreen"),
     ("publish", "roc.tui.call_screens", "PublishScreen"),

@@ -64,6 +64,8 @@ class Rates:
     def __init__(self, size: int = LIST_WINDOW):
         self.size = size
         self.windows: dict[str, Window] = {}
+        self.in_view: set[str] | None = None  # the topics whose texts are measured again (None: all)
+        self._texts: dict[str, tuple[str, str]] = {}
 
     def add(self, event: dict[str, Any]) -> None:
         """Take a ``batch`` event."""
@@ -74,6 +76,8 @@ class Rates:
         """Forget the topics that are gone."""
         for topic in set(self.windows) - topics:
             del self.windows[topic]
+        for topic in set(self._texts) - topics:
+            del self._texts[topic]
 
     def rate(self, topic: str) -> float | None:
         window = self.windows.get(topic)
@@ -84,6 +88,13 @@ class Rates:
         measured = window.bandwidth() if window else None
         return measured["bytes_per_second"] if measured else None
 
+    def texts(self, topic: str) -> tuple[str, str]:
+        """The rate and bandwidth as the list shows them: measured again for a topic in view, the last
+        ones for the others (200 topics measured every second cost more than everything else drawn)."""
+        if self.in_view is None or topic in self.in_view or topic not in self._texts:
+            self._texts[topic] = (rate_text(self.rate(topic)), bandwidth_text(self.bandwidth(topic)))
+        return self._texts[topic]
+
 
 def visible(entries: list[dict[str, Any]], hidden: bool) -> list[dict[str, Any]]:
     """Entries without a hidden name (ros2's rule), unless ``hidden``; topics counted without the
@@ -93,8 +104,8 @@ def visible(entries: list[dict[str, Any]], hidden: bool) -> list[dict[str, Any]]
 
 
 def topic_rows(snapshot: dict[str, Any], rates: Rates, hidden: bool = False) -> list[Row]:
-    return [Row(t["name"], (t["name"], str(t["publishers"]), str(t["subscribers"]), rate_text(rates.rate(t["name"])),
-                            bandwidth_text(rates.bandwidth(t["name"])), ", ".join(t["types"])), topic_diagnoses(t))
+    return [Row(t["name"], (t["name"], str(t["publishers"]), str(t["subscribers"]), *rates.texts(t["name"]),
+                            ", ".join(t["types"])), topic_diagnoses(t))
             for t in visible(snapshot["topics"], hidden)]
 
 

@@ -1,5 +1,5 @@
 """The command palette (``:``): every view by name (``nodes``, ``topics``, ``logs [NODE]``, ``plot TOPIC
-FIELD...``, ``diagnostics``, ``frames``, ``bag PATH``, ``launch``, ``build``, ``publish TOPIC``), and
+FIELD...``, ``image TOPIC``, ``diagnostics``, ``frames``, ``bag PATH``, ``launch``, ``build``, ``publish TOPIC``), and
 any node, topic, service or action of the graph by its name."""
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ VIEWS = {
     "actions": ("", "the actions of the graph"),
     "logs": ("[NODE]", "/rosout live, filtered by level, node and text"),
     "plot": ("TOPIC FIELD [FIELD...]", "numeric fields against time"),
+    "image": ("TOPIC", "an image topic drawn in the terminal (sensor_msgs Image, CompressedImage)"),
     "diagnostics": ("", "/diagnostics by hardware id and name, worst first"),
     "frames": ("", "the live tf tree"),
     "publish": ("TOPIC", "publish a message on a topic, once or at a rate"),
@@ -24,7 +25,7 @@ VIEWS = {
     "launch": ("", "the roc launch runs of this host: processes, output, restart, stop"),
     "build": ("", "roc work build of the workspace, shown live"),
 }
-NEEDS_WORDS = {"plot", "publish", "bag"}
+NEEDS_WORDS = {"plot", "image", "publish", "bag"}
 
 
 def palette_lines() -> list[str]:

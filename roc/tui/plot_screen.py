@@ -1,11 +1,14 @@
 """A plot: numeric fields of one or more topics against time (textual-plotext, on plotext), live. The
-daemon sends only the fields asked for (its ``values`` stream with ``fields``), so a 1 kHz topic is a
-few batches of numbers a second; the screen draws at most DRAW_SECONDS apart, two points per column.
+daemon sends only the fields asked for (its ``values`` stream with ``fields``); the streams' threads
+leave the batches in an inbox that the screen empties when it draws: when something changed, at most
+every DRAW_SECONDS (or as long as the window takes to move by one column), two points per column.
 Space pauses the view, ``+``/``-`` zoom the time window, ``a`` adds a field, ``r`` removes the last,
 ``s`` writes the samples to a CSV file."""
 
 from __future__ import annotations
 
+import time
+from collections import deque
 from functools import partial
 from pathlib import Path
 
@@ -22,9 +25,28 @@ from roc.fsutil import write_text_atomic
 from roc.tui.plotting import Series, csv_text, thinned
 from roc.tui.widgets import Prompt, host
 
-DRAW_SECONDS = 0.5
+DRAW_SECONDS = 0.5  # at most twice a second
+DRAW_SHARE = 0.04  # and so rarely that drawing takes at most this share of a core (plotext takes 10 to 100 ms)
+BATCH_SECONDS = 0.05  # the daemon sends a fast topic's samples in batches this far apart
 WINDOWS = (1, 2, 5, 10, 30, 60, 120, 300, 600)  # seconds shown, ``+``/``-`` go through them
 NS = 1e-9
+
+
+class TimedPlot(PlotextPlot):
+    """A plotext plot that keeps how much CPU its last drawing took, in the terminal's own colours
+    (plotext's ``pro`` theme: only the lines are coloured, a third of the escape codes to decode)."""
+
+    def __init__(self, **options) -> None:
+        super().__init__(**options)
+        self.theme = "pro"
+        self.cost = 0.0  # seconds of CPU
+
+    def render(self):
+        started = time.thread_time()
+        try:
+            return super().render()
+        finally:
+            self.cost = time.thread_time() - started
 
 
 class PlotScreen(Screen):
@@ -39,7 +61,7 @@ class PlotScreen(Screen):
     ]
     DEFAULT_CSS = """
     PlotScreen #title { height: 1; background: $primary; }
-    PlotScreen PlotextPlot { height: 1fr; }
+    PlotScreen TimedPlot { height: 1fr; }
     """
 
     def __init__(self, fields: list[tuple[str, str]]) -> None:
@@ -51,16 +73,19 @@ class PlotScreen(Screen):
         self.latest = 0.0  # the newest sample's time
         self.received = self.lost = 0
         self.errors: dict[str, str] = {}
+        self.inbox: deque[tuple[str, dict]] = deque()  # (topic, samples event), from the streams' threads
+        self.changed = True  # something to draw
+        self.drawn_at = 0.0  # time.monotonic() of the last drawing
 
     def compose(self) -> ComposeResult:
         yield Static("", id="title")
-        yield PlotextPlot(id="plot")
+        yield TimedPlot(id="plot")
         yield Footer()
 
     def on_mount(self) -> None:
         for topic in self.topics():
             self.subscribe(topic)
-        self.set_interval(DRAW_SECONDS, self.draw)
+        self.set_interval(DRAW_SECONDS, self.tick)
         self.draw()
 
     def topics(self) -> list[str]:
@@ -76,12 +101,26 @@ class PlotScreen(Screen):
         if not paths:
             return
         try:
-            params = {"topic": topic, "fields": paths}
+            params = {"topic": topic, "fields": paths, "period": BATCH_SECONDS}
             for event in host(self).feed.stream("values", params, lambda: worker.is_cancelled):
                 if event["event"] == "samples":
-                    self.app.call_from_thread(self.take, topic, event)
+                    self.inbox.append((topic, event))
         except RocError as error:
             self.errors[topic] = str(error)
+            self.changed = True
+
+    def tick(self) -> None:
+        """Take what arrived; draw when it changes what is shown and the window has moved by a column."""
+        arrived = bool(self.inbox)
+        while self.inbox:
+            self.take(*self.inbox.popleft())
+        plot = self.query_one(TimedPlot)
+        columns = max(10, plot.size.width - 12)
+        due = self.drawn_at + max(DRAW_SECONDS, self.window / columns, plot.cost / DRAW_SHARE) * 0.9
+        if self.changed and time.monotonic() >= due:
+            self.draw()
+        elif arrived:
+            self.draw_title()
 
     def take(self, topic: str, event: dict) -> None:
         times = [t * NS for t in event["time"]]
@@ -92,15 +131,20 @@ class PlotScreen(Screen):
         self.lost += event.get("lost", 0)
         if times:
             self.latest = max(self.latest, times[-1])
+            self.changed = self.changed or self.paused_at is None
 
-    def draw(self) -> None:
-        end = self.paused_at if self.paused_at is not None else self.latest
-        start = end - self.window
+    def draw_title(self) -> None:
         state = "paused (Space: resume)" if self.paused_at is not None else "live (Space: pause)"
         errors = "  ".join(f"{topic}: {error}" for topic, error in self.errors.items())
         self.query_one("#title", Static).update(Text(
             f"plot, last {self.window} s, {state}  {self.received} samples, {self.lost} lost  {errors}", style="bold"))
-        widget = self.query_one(PlotextPlot)
+
+    def draw(self) -> None:
+        self.changed, self.drawn_at = False, time.monotonic()
+        end = self.paused_at if self.paused_at is not None else self.latest
+        start = end - self.window
+        self.draw_title()
+        widget = self.query_one(TimedPlot)
         plt = widget.plt
         plt.clear_data()
         plt.clear_figure()

@@ -1,6 +1,6 @@
 """A topic: its endpoints with their QoS and the problems between them, its rate and bandwidth (as
 ``roc topic hz`` and ``bw`` measure them), and a live echo of its latest message: ``p`` pauses it,
-``f`` shows one field."""
+``f`` shows one field, ``i`` draws an image topic."""
 
 from __future__ import annotations
 
@@ -47,6 +47,7 @@ class TopicScreen(Screen):
         Binding("f", "field", "field"),
         Binding("g", "plot", "plot a numeric field"),
         Binding("u", "publish", "publish on the topic"),
+        Binding("i", "image", "the image (sensor_msgs Image, CompressedImage) drawn"),
     ]
     DEFAULT_CSS = """
     TopicScreen #title { height: 1; background: $primary; }
@@ -186,3 +187,11 @@ class TopicScreen(Screen):
 
     def action_publish(self) -> None:
         host(self).open("publish", self.topic)
+
+    def action_image(self) -> None:
+        from roc.tui.images import TYPES
+
+        if self.type_name in TYPES:
+            host(self).open("image", self.topic)
+        else:
+            self.notify(f"{self.topic} is no image topic ({self.type_name or 'type unknown'})", severity="warning")

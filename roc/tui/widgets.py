@@ -11,7 +11,7 @@ from textual.app import ComposeResult
 from textual.binding import Binding, BindingType
 from textual.containers import Vertical
 from textual.screen import ModalScreen
-from textual.widgets import DataTable, Input, Static, TextArea
+from textual.widgets import DataTable, Input, Static
 from textual.widgets.data_table import ColumnKey
 
 from roc.tui.feed import Feed
@@ -78,6 +78,14 @@ class ListTable(DataTable):
         for name in self.columns_names:
             self.add_column(name, key=name, width=self.widths.get(name))
 
+    def _on_hide(self, event) -> None:
+        """A focused table that its tab hides lets the focus go, instead of Textual's move to a visible
+        sibling: in a hidden tab the sibling is hidden too, and focusing it brings its tab back (the
+        first screen's Tab or ``3`` then bounced back to the nodes). The screen focuses the new tab's list."""
+        if self.screen.focused is self:  # not has_focus: it follows a moment later, by a Blur event
+            self.screen.set_focus(None)
+        super()._on_hide(event)
+
     def _update_dimensions(self, new_rows) -> None:
         """DataTable's, then the rows drawn before they were measured are drawn again where their columns
         widened: Textual 8.2 does that only on a Resize event, which does not always follow (a screen kept
@@ -98,25 +106,30 @@ class ListTable(DataTable):
     def show(self, rows: Iterable[Row]) -> None:
         self._all = list(rows)
         shown = [r for r in self._all if not self.filter or matches(self.filter, *r.cells)]
+        if not self._shown and len(shown) > self.app.size.height:
+            # the first fill: the rows a screen can show now (a first paint of 200 topics costs their
+            # measuring), the others right after it is painted
+            shown = shown[:self.app.size.height]
+            self.call_after_refresh(lambda: self.show(self._all))
         keys = [r.key for r in shown]
-        if keys != self._shown:
-            current = self.selected_key()
+        current = self.selected_key()
+        if keys[:len(self._shown)] != self._shown:  # rows gone or moved: all drawn again
             self.clear()
-            for row in shown:
-                self.add_row(*self._cells(row), key=row.key)
-            if current in keys:
-                self.move_cursor(row=keys.index(current), animate=False)
-        else:
-            columns = (["!"] if self.marks else []) + list(self.columns_names)
-            for row in shown:
-                old = self.rows_by_key.get(row.key)
-                if old == row:
-                    continue
-                for column, value, before in zip(columns, self._cells(row), self._cells(old) if old else []):
-                    if value != before:
-                        width = self.columns[ColumnKey(column)].content_width
-                        grows = column not in self.widths and value.cell_len > width
-                        self.update_cell(row.key, column, value, update_width=grows)
+            self._shown, self.rows_by_key = [], {}
+        columns = (["!"] if self.marks else []) + list(self.columns_names)
+        for row in shown[:len(self._shown)]:  # the rows drawn before: only their changed cells
+            old = self.rows_by_key.get(row.key)
+            if old == row:
+                continue
+            for column, value, before in zip(columns, self._cells(row), self._cells(old) if old else []):
+                if value != before:
+                    width = self.columns[ColumnKey(column)].content_width
+                    grows = column not in self.widths and value.cell_len > width
+                    self.update_cell(row.key, column, value, update_width=grows)
+        for row in shown[len(self._shown):]:  # new rows, at the end
+            self.add_row(*self._cells(row), key=row.key)
+        if not self._shown and current in keys:
+            self.move_cursor(row=keys.index(current), animate=False)
         self._shown = keys
         self.rows_by_key = {r.key: r for r in shown}
 
@@ -137,6 +150,11 @@ class ListTable(DataTable):
     def selected(self) -> Row | None:
         key = self.selected_key()
         return self.rows_by_key.get(key) if key else None
+
+    def keys_in_view(self, margin: int = 2) -> set[str]:
+        """The keys of the rows on the screen (and ``margin`` more each side)."""
+        first = int(self.scroll_y)
+        return set(self._shown[max(0, first - margin):first + self.size.height + margin])
 
     @property
     def shown_count(self) -> int:
@@ -185,6 +203,8 @@ class TextViewer(ModalScreen[None]):
     def compose(self) -> ComposeResult:
         with Vertical():
             yield Static(Text(self.title_text, style="bold"))
+            from textual.widgets import TextArea  # not before a viewer opens: a first screen without it is faster
+
             yield TextArea(self.text, read_only=True, soft_wrap=False, id="viewer")
 
     def action_close(self) -> None:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 import re
+import shlex
 import subprocess
 import sys
 import time
@@ -50,14 +51,50 @@ def table(app, selector: str) -> ListTable:
 
 
 async def open_row(app, pilot, tab: str, name: str) -> None:
-    """Filter the list of ``tab`` down to ``name`` and press Enter on it."""
+    """Filter the list of ``tab`` down to ``name`` and press Enter on it. Each key waits for what the one
+    before did (the pilot's keys do not wait on a loaded machine): typed before the filter had the focus,
+    the name's letters were the list's keys (``p`` next problem, ``f`` tf frames, ``c``)."""
+    from textual.widgets import Input
+
     keys = {"nodes": "1", "topics": "2", "services": "3", "actions": "4"}
     await pilot.press(keys[tab])
-    await until(pilot, lambda: name in table(app, f"#{tab}-table").rows_by_key, what=name)
-    await pilot.press("slash", *name, "enter")
     rows = table(app, f"#{tab}-table")
-    await until(pilot, lambda: rows.selected_key() == name, what=f"{name} alone")
+    if rows.filter:  # one kept from before
+        await until(pilot, lambda: app.focused is rows, what=f"the {tab}")
+        await pilot.press("escape")
+    await until(pilot, lambda: name in rows.rows_by_key and app.focused is rows, what=f"{name} in the {tab}")
+    await pilot.press("slash")
+    box = app.screen.query_one("#filter", Input)
+    await until(pilot, lambda: app.focused is box, what="the filter's input")
+    await pilot.press(*name)
+    try:
+        await until(pilot, lambda: rows.filter == name and rows.selected_key() == name, what=f"{name} alone")
+    except AssertionError as error:
+        raise AssertionError(f"{error} (focused: {app.focused}); the screen:\n" + "\n".join(screen_lines(app))) from None
+    await pilot.press("enter")  # the filter kept, the list focused
+    await until(pilot, lambda: app.focused is rows, what="the filtered list")
     await pilot.press("enter")
+
+
+async def palette_command(app, pilot, command: str, entry: str | None = None) -> None:
+    """Type ``command`` into the command palette (``:``) and run its ``entry`` (the command itself
+    unless given) once the palette highlights it."""
+    from textual.command import CommandInput, CommandList, CommandPalette
+
+    await pilot.press("colon")
+    await until(pilot, lambda: isinstance(app.screen, CommandPalette) and isinstance(app.focused, CommandInput),
+                what="the command palette")
+    await pilot.press(*command)
+    palette, entry = app.screen, entry or command
+
+    def highlighted() -> str:
+        found = palette.query_one(CommandList)
+        if found.highlighted is None or palette.query_one(CommandInput).value != command:
+            return ""
+        return str(found.get_option_at_index(found.highlighted).hit.text)
+    await until(pilot, lambda: highlighted() == entry, what=f"the palette's entry {entry!r}")
+    await pilot.press("enter")
+    await until(pilot, lambda: app.screen is not palette, what=f"{entry} run")
 
 
 CMAKE = "cmake_minimum_required(VERSION 3.10)\nproject({name} NONE)\n{extra}"
@@ -145,3 +182,71 @@ def picture(app, name: str) -> None:
     """With ROC_UPDATE_SNAPSHOTS=1, the screen as the manual's picture docs/images/tui-NAME.svg."""
     if os.environ.get("ROC_UPDATE_SNAPSHOTS") == "1":
         (IMAGES / f"tui-{name}.svg").write_text(app.export_screenshot(title="roc tui"))
+
+
+def require_tmux() -> None:
+    """At a module's top: skip its tests without tmux (a test-time tool: ROC_SETUP_TEST_TOOLS=1 bash
+    scripts/setup.sh installs it), except in CI, where they fail."""
+    import shutil
+
+    import pytest
+
+    if shutil.which("tmux") is None:
+        if os.environ.get("CI"):
+            raise RuntimeError("tmux is missing in CI: ROC_SETUP_TEST_TOOLS=1 bash scripts/setup.sh installs it")
+        pytest.skip("tmux is not installed (ROC_SETUP_TEST_TOOLS=1 bash scripts/setup.sh installs it)",
+                    allow_module_level=True)
+
+
+class Terminal:
+    """One tmux session (on a private socket) of ``size`` running ``command``; ``screen()`` is what it
+    shows, ``keys`` types."""
+
+    def __init__(self, directory: Path, command: list[str], env: dict[str, str], cwd: Path,
+                 size: tuple[int, int] = SIZE) -> None:
+        self.socket = directory / "tmux.sock"
+        self.status = directory / "status"
+        script = directory / "run.sh"
+        # never COLUMNS and LINES: pytest-xdist's workers have them (80, 24), and Textual takes them for the size
+        exports = "unset COLUMNS LINES\n" + "".join(
+            f"export {name}={shlex.quote(value)}\n" for name, value in env.items()
+            if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name) and name not in ("COLUMNS", "LINES"))
+        script.write_text(f"{exports}cd {shlex.quote(str(cwd))}\n{shlex.join(command)}\n"
+                          f"echo $? > {shlex.quote(str(self.status))}\nsleep 60\n")
+        config = directory / "tmux.conf"
+        config.write_text("set -g status off\n")  # every line for roc
+        self.tmux("-f", str(config), "new-session", "-d", "-x", str(size[0]), "-y", str(size[1]), "-s", "roc",
+                  f"bash {shlex.quote(str(script))}")
+
+    def tmux(self, *args: str) -> str:
+        return subprocess.run(["tmux", "-S", str(self.socket), *args], check=True, capture_output=True, text=True,
+                              timeout=20, env={**os.environ, "TERM": "xterm-256color"}).stdout
+
+    def screen(self, escapes: bool = False) -> str:
+        return self.tmux("capture-pane", "-p", *(["-e"] if escapes else []), "-t", "roc")
+
+    def keys(self, *keys: str, literal: bool = False) -> None:
+        self.tmux("send-keys", "-t", "roc", *(["-l"] if literal else []), *keys)
+
+    def wait(self, condition: Callable[[str], bool], what: str, timeout: float = 60.0) -> str:
+        deadline = time.monotonic() + timeout
+        while True:
+            screen = self.screen()
+            if condition(screen):
+                return screen
+            assert time.monotonic() < deadline, f"timed out waiting for {what}; the screen:\n{screen}"
+            time.sleep(0.2)
+
+    def exit_code(self, timeout: float = 30.0) -> int:
+        deadline = time.monotonic() + timeout
+        while not self.status.exists() or not self.status.read_text().strip():
+            assert time.monotonic() < deadline, f"roc did not exit; the screen:\n{self.screen()}"
+            time.sleep(0.2)
+        return int(self.status.read_text())
+
+    def close(self) -> None:
+        subprocess.run(["tmux", "-S", str(self.socket), "kill-server"], capture_output=True, timeout=20)
+
+
+# an SGR sequence that sets a foreground or background colour (39 and 49, the defaults, do not count)
+COLOUR = re.compile(r"\x1b\[(?:[0-9]+;)*(?:3[0-8]|4[0-8]|9[0-7]|10[0-7])(?:;[0-9]+)*m")

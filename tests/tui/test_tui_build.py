@@ -82,8 +82,9 @@ def test_a_build_started_from_the_packages_list(tmp_path: Path, monkeypatch) -> 
             assert packages.rows_by_key["good"].cells[2] == "not built"
             await pilot.press("B")
             await until(pilot, lambda: app.build is not None and app.build.board.finished, 120, "the build")
-            await pilot.pause(0.5)
             tasks = table(app, "#tasks")
+            await until(pilot, lambda: "after" in tasks.rows_by_key and tasks.rows_by_key["after"].cells[1] == "not started",
+                        what="the end of the run listed")
             states = {key: row.cells[1] for key, row in tasks.rows_by_key.items()}
             # the first failure stops the run (no --continue-on-error): good may be stopped too
             assert states["broken"] == "failed" and states["after"] == "not started", states

@@ -19,6 +19,7 @@ from helpers.graph import graph_env, read_line, roc, start_nodes, stop_all
 from helpers.tui import (
     GRAPH,
     live_graph,
+    palette_command,
     picture,
     screen_lines,
     screen_name,
@@ -110,15 +111,6 @@ async def open_node(app, pilot, name: str) -> None:
     await until(pilot, lambda: screen_name(app) == "NodeScreen", what="the node screen")
 
 
-async def palette(pilot, command: str) -> None:
-    """Type ``command`` into the command palette and run it."""
-    await pilot.press("colon")
-    await pilot.pause(0.3)
-    await pilot.press(*command)
-    await pilot.pause(0.5)
-    await pilot.press("enter")
-
-
 def test_logs_of_a_node_filtered_by_level_and_text_paused_and_followed(graph) -> None:
     async def test() -> None:
         app = RocApp()
@@ -163,7 +155,7 @@ def test_a_plot_of_two_fields_zoomed_paused_and_saved_as_csv(graph, tmp_path) ->
         app = RocApp()
         async with app.run_test(size=(100, 30)) as pilot:
             await until(pilot, lambda: app.graph_screen.snapshot is not None, what="the graph")
-            await palette(pilot, "plot /pose pose.position.x pose.position.y")
+            await palette_command(app, pilot, "plot /pose pose.position.x pose.position.y")
             await until(pilot, lambda: screen_name(app) == "PlotScreen", what="the plot")
             plot = app.screen
             await until(pilot, lambda: all(len(s.times) >= 50 for s in plot.series), what="samples")
@@ -197,7 +189,7 @@ def test_diagnostics_grouped_worst_first_with_history(graph) -> None:
     async def test() -> None:
         app = RocApp()
         async with app.run_test(size=(100, 30)) as pilot:
-            await palette(pilot, "diagnostics")
+            await palette_command(app, pilot, "diagnostics")
             await until(pilot, lambda: screen_name(app) == "DiagnosticsScreen", what="the diagnostics")
             statuses = lambda: app.screen.query_one("#statuses").rows_by_key  # noqa: E731
             await until(pilot, lambda: len(statuses()) == 3, what="three statuses")
@@ -248,7 +240,7 @@ def test_publish_once_and_at_a_rate_from_the_form(graph) -> None:
         app = RocApp()
         async with app.run_test(size=(100, 30)) as pilot:
             await until(pilot, lambda: app.graph_screen.snapshot is not None, what="the graph")
-            await palette(pilot, "publish /cmd_vel")
+            await palette_command(app, pilot, "publish /cmd_vel")
             await until(pilot, lambda: screen_name(app) == "PublishScreen", what="the form")
             editor = app.screen.query_one("#editor")
             assert "linear:" in editor.text and "x: 0.0" in editor.text  # the prototype of geometry_msgs/Twist

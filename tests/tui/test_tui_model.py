@@ -74,7 +74,7 @@ def test_the_manual_lists_every_key_and_command() -> None:
     manual = MANUAL.read_text()
     assert "<!-- tui-keys -->" in manual and "<!-- tui-commands -->" in manual
     listed = {name for _, _, name in SCREENS}
-    for module in ("app", "graph_screen", "node_screen", "topic_screen", "logs_screen", "plot_screen",
+    for module in ("app", "graph_screen", "node_screen", "topic_screen", "logs_screen", "plot_screen", "image_screen",
                    "diagnostics_screen", "call_screens", "bag_screen", "launch_screen", "frames_screen", "build_screen"):
         for name, cls in inspect.getmembers(importlib.import_module(f"roc.tui.{module}"), inspect.isclass):
             if issubclass(cls, Screen) and cls.__module__ == f"roc.tui.{module}" and "BINDINGS" in vars(cls) \
@@ -92,7 +92,7 @@ def test_the_tui_loads_no_rclpy() -> None:
     code = ("import sys, roc.commands.tui, roc.tui.app, roc.tui.graph_screen, roc.tui.node_screen, "
             "roc.tui.topic_screen, roc.tui.call_screens, roc.tui.frames_screen, roc.tui.build_screen, "
             "roc.tui.logs_screen, roc.tui.plot_screen, roc.tui.diagnostics_screen, roc.tui.bag_screen, "
-            "roc.tui.launch_screen, roc.launch.status; "
+            "roc.tui.launch_screen, roc.tui.image_screen, roc.tui.images, roc.launch.status; "
             "print(sorted(m for m in sys.modules if m.split('.')[0] == 'rclpy'))")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, done.stderr

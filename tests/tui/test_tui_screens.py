@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 import yaml
 from helpers.graph import DEMO_GRAPH, graph_env, roc
-from helpers.tui import SIZE, live_graph, open_row, table, text_of, until
+from helpers.tui import SIZE, live_graph, open_row, palette_command, table, text_of, until
 
 from roc.tui.app import RocApp
 
@@ -207,11 +207,7 @@ def test_tab_keys_and_the_command_palette(graph) -> None:
             await pilot.press("H")  # hidden names too (never roc's own participants)
             await until(pilot, lambda: "/_helper" in nodes.rows_by_key, what="hidden")
             assert not any(name.startswith("/_roc_") for name in nodes.rows_by_key)
-            await pilot.press("colon")
-            await until(pilot, lambda: type(app.screen).__name__ == "CommandPalette")
-            await pilot.press(*"node motor_con")
-            await pilot.pause(0.5)
-            await pilot.press("enter")
+            await palette_command(app, pilot, "node motor_con", "node /motor_controller")
             await until(pilot, lambda: type(app.screen).__name__ == "NodeScreen", what="the node, from the palette")
             assert app.screen.node == "/motor_controller"
     drive(test)

@@ -29,6 +29,7 @@ from roc.engine.events import (
 )
 from roc.tui.app import RocApp
 from roc.tui.feed import Feed
+from roc.tui.processes import Processes, Usage
 
 pytestmark = pytest.mark.slow
 SNAPSHOTS = DATA / "tui"
@@ -50,6 +51,15 @@ class StillFeed(Feed):
 
     def stream(self, method, params, stop):
         return iter(())
+
+
+class StillProcesses(Processes):
+    """The nodes' processes found, their CPU and memory shown as the same numbers in every run."""
+
+    def update(self, snapshot):
+        self.usage = {node: Usage(found.pid, 1.0, 50_000_000, found.nodes) if found.pid is not None else found
+                      for node, found in super().update(snapshot).items()}
+        return self.usage
 
 
 @pytest.fixture(scope="module")
@@ -100,6 +110,7 @@ def test_main_screens(graph) -> None:
     async def test() -> None:
         app = RocApp(feed=StillFeed())
         async with app.run_test(size=SIZE) as pilot:
+            app.graph_screen.processes = StillProcesses()
             await graph_ready(app, pilot)
             topics = table(app, "#topics-table")
             topics.move_cursor(row=list(topics.rows_by_key).index("/robot1/image"))

@@ -4,79 +4,20 @@ are skipped, except in CI, where they fail."""
 
 from __future__ import annotations
 
-import os
 import re
-import shlex
-import shutil
 import subprocess
 import sys
-import time
-from collections.abc import Callable
 from pathlib import Path
 
 import pytest
-from helpers.build import BIN, NODES, REPO, ros_env, stop_process
-from helpers.graph import graph_env, read_line, start_nodes, stop_all, stop_daemon
-from helpers.tui import make_workspace
+from helpers.build import BIN, NODES, ros_env, stop_process
+from helpers.graph import graph_env, read_line, start_nodes, stop_all, stop_daemon, with_tf2_msgs
+from helpers.tui import COLOUR, Terminal, make_workspace, require_tmux
 
 pytestmark = pytest.mark.slow
 TF_NODE = NODES / "tf_node.py"
 
-if shutil.which("tmux") is None:
-    if os.environ.get("CI"):
-        raise RuntimeError("tmux is missing in CI: ROC_SETUP_TEST_TOOLS=1 bash scripts/setup.sh installs it")
-    pytest.skip("tmux is not installed (ROC_SETUP_TEST_TOOLS=1 bash scripts/setup.sh installs it)",
-                allow_module_level=True)
-
-
-class Terminal:
-    """One tmux session of 80x24 running ``command``; ``screen()`` is what it shows."""
-
-    def __init__(self, directory: Path, command: list[str], env: dict[str, str], cwd: Path) -> None:
-        self.socket = directory / "tmux.sock"
-        self.status = directory / "status"
-        script = directory / "run.sh"
-        exports = "".join(f"export {name}={shlex.quote(value)}\n" for name, value in env.items()
-                          if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name))
-        script.write_text(f"{exports}cd {shlex.quote(str(cwd))}\n{shlex.join(command)}\n"
-                          f"echo $? > {shlex.quote(str(self.status))}\nsleep 60\n")
-        config = directory / "tmux.conf"
-        config.write_text("set -g status off\n")  # all 24 lines for roc
-        self.tmux("-f", str(config), "new-session", "-d", "-x", "80", "-y", "24", "-s", "roc",
-                  f"bash {shlex.quote(str(script))}")
-
-    def tmux(self, *args: str) -> str:
-        return subprocess.run(["tmux", "-S", str(self.socket), *args], check=True, capture_output=True, text=True,
-                              timeout=20, env={**os.environ, "TERM": "xterm-256color"}).stdout
-
-    def screen(self, escapes: bool = False) -> str:
-        return self.tmux("capture-pane", "-p", *(["-e"] if escapes else []), "-t", "roc")
-
-    def keys(self, *keys: str, literal: bool = False) -> None:
-        self.tmux("send-keys", "-t", "roc", *(["-l"] if literal else []), *keys)
-
-    def wait(self, condition: Callable[[str], bool], what: str, timeout: float = 60.0) -> str:
-        deadline = time.monotonic() + timeout
-        while True:
-            screen = self.screen()
-            if condition(screen):
-                return screen
-            assert time.monotonic() < deadline, f"timed out waiting for {what}; the screen:\n{screen}"
-            time.sleep(0.2)
-
-    def exit_code(self, timeout: float = 30.0) -> int:
-        deadline = time.monotonic() + timeout
-        while not self.status.exists() or not self.status.read_text().strip():
-            assert time.monotonic() < deadline, f"roc did not exit; the screen:\n{self.screen()}"
-            time.sleep(0.2)
-        return int(self.status.read_text())
-
-    def close(self) -> None:
-        subprocess.run(["tmux", "-S", str(self.socket), "kill-server"], capture_output=True, timeout=20)
-
-
-# an SGR sequence that sets a foreground or background colour (39 and 49, the defaults, do not count)
-COLOUR = re.compile(r"\x1b\[(?:[0-9]+;)*(?:3[0-8]|4[0-8]|9[0-7]|10[0-7])(?:;[0-9]+)*m")
+require_tmux()
 
 
 @pytest.mark.parametrize("no_color", [False, True], ids=["colour", "NO_COLOR"])
@@ -132,17 +73,10 @@ def test_work_build_tui_in_a_terminal(tmp_path: Path) -> None:
 
 def test_the_tf_tree_in_a_terminal(tmp_path: Path) -> None:
     """The tf screen (f): each frame under its parent with its rate and publishing node, live; tf2_msgs
-    built by roc from the example workspace and sourced, the tree published by tests/nodes/tf_node.py."""
-    workspace = tmp_path / "tf"
-    shutil.copytree(REPO / "workspaces" / "example" / "src" / "tf2_msgs", workspace / "src" / "tf2_msgs")
-    built = subprocess.run([str(BIN / "roc"), "work", "build"], cwd=workspace, env=ros_env(), capture_output=True,
-                           text=True, timeout=600)
-    assert built.returncode == 0, built.stdout + built.stderr
+    built by roc from the example workspace (once per test run: helpers.graph.with_tf2_msgs) and sourced,
+    the tree published by tests/nodes/tf_node.py."""
     (tmp_path / "runtime").mkdir()
-    env = graph_env(38, tmp_path / "runtime", TERM="xterm-256color")
-    dumped = subprocess.run(["bash", "-c", f'source "{workspace}/install/setup.bash" && env -0'], env=env,
-                            capture_output=True, timeout=60, check=True)
-    env = dict(item.split("=", 1) for item in dumped.stdout.decode().split("\0") if "=" in item)
+    env = with_tf2_msgs(graph_env(38, tmp_path / "runtime", TERM="xterm-256color"))
     publisher = subprocess.Popen([sys.executable, str(TF_NODE), "publish"], env=env, stdout=subprocess.PIPE,
                                  stderr=subprocess.DEVNULL, text=True)
     terminal = Terminal(tmp_path, [str(BIN / "roc"), "tui", "--no-workspace"], env, tmp_path)
@@ -156,7 +90,7 @@ def test_the_tf_tree_in_a_terminal(tmp_path: Path) -> None:
         assert "map" in lines and "└── odom [static, /tf_publish]" in lines, screen
         assert "└── laser [static, /tf_publish]" in lines, screen
         terminal.keys("Escape")  # then wait: Esc and q at once read as Alt+Q
-        terminal.wait(lambda s: "Topics" in s and "tf frames (from" not in s, "the graph again")
+        terminal.wait(lambda s: "System" in s and "tf frames (from" not in s, "the first screen again")
         terminal.keys("q")
         assert terminal.exit_code() == 0
     finally:

@@ -189,7 +189,7 @@ def _check_supported(args: argparse.Namespace) -> None:
 
 def run(args: argparse.Namespace) -> int:
     if args.tui and not args.explain:
-        from roc.tui.app import require_terminal
+        from roc.tui import require_terminal
 
         require_terminal("--tui")
     workspace, options, switches, remote = _prepare(args)
