@@ -175,15 +175,19 @@ def test_the_publisher_sends_only_what_passes(numbers, tmp_path):
                              str(BIN / "roc")], env=env, capture_output=True, text=True, timeout=180)
     assert result.returncode == 0, result.stderr
     runs = json.loads(result.stdout)
-    print({name: (round(run["wire_bytes_per_second"]), round(run["bw"]["bytes_per_second"]))
+    print({name: (round(run["wire_bytes_per_message"]), run["published"], round(run["bw"]["bytes_per_second"]))
            for name, run in runs.items()})
-    wire = {name: run["wire_bytes_per_second"] for name, run in runs.items()}
     delivered = {name: run["bw"]["bytes_per_second"] for name, run in runs.items()}
     # what reaches roc topic bw: every message unfiltered, the tenth that passes with either filter
     # (ratios: a loaded machine publishes less than 100 Hz, each run at its own pace)
     assert delivered["middleware"] == pytest.approx(delivered["unfiltered"] / 10, rel=0.35)
     assert delivered["roc"] == pytest.approx(delivered["unfiltered"] / 10, rel=0.35)
-    # what crosses the wire: what is delivered, plus the protocol's own, unless roc filters
-    assert wire["unfiltered"] < 1.5 * delivered["unfiltered"]
-    assert wire["middleware"] < 2 * delivered["middleware"]
-    assert wire["roc"] > 5 * delivered["roc"]
+    # what crosses the wire for each message published: the message and the protocol's own unfiltered; a
+    # tenth of that with the middleware's filter; much more when roc filters (all of it on a quiet machine,
+    # 2216, 283 and 2216 bytes; on a loaded one the bytes sent lag the messages published, down to 867
+    # unfiltered: the bounds leave room for that; content_filter_bench.py measures the ratios)
+    wire = {name: run["wire_bytes_per_message"] for name, run in runs.items()}
+    assert all(run["published"] >= 20 for run in runs.values()), runs
+    assert wire["unfiltered"] < 1.5 * 2000
+    assert wire["middleware"] < 0.5 * wire["unfiltered"]
+    assert wire["roc"] > 2 * wire["middleware"]

@@ -4,7 +4,8 @@ RATE Hz messages of SIZE bytes (content_filter_node.py), then ``roc topic bw`` o
 seconds unfiltered, with a filter the middleware evaluates, and with the same filter evaluated by roc
 (ROC_MIDDLEWARE_CONTENT_FILTER=0). Fast DDS is told to use UDP only (no shared memory), so every
 byte it sends crosses the loopback interface. Prints one JSON object: per run, the bytes the
-interface carried per second and what roc topic bw measured.
+interface carried per second and per message published meanwhile (a loaded machine publishes less
+than RATE), and what roc topic bw measured.
 
     unshare -n python content_filter_wire.py RATE SIZE WINDOW ROC"""
 
@@ -15,6 +16,7 @@ import os
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -35,8 +37,13 @@ def loopback_bytes() -> int:
 def measure(roc: str, window: float, extra: list[str], env: dict[str, str], rate: str, size: str) -> dict:
     """A fresh publisher (no reader of an earlier run still matched) and roc topic bw for ``window``
     seconds from its first report: the loopback's bytes per second and bw's last report."""
-    publisher = subprocess.Popen([sys.executable, str(HERE / "content_filter_node.py"), rate, size], env=env,
-                                 stdout=subprocess.PIPE, text=True)
+    counter = Path(tempfile.mkdtemp()) / "published"
+    publisher = subprocess.Popen([sys.executable, str(HERE / "content_filter_node.py"), rate, size, str(counter)],
+                                 env=env, stdout=subprocess.PIPE, text=True)
+
+    def published() -> int:
+        return int(counter.read_text() or 0)
+
     bw = None
     try:
         assert publisher.stdout.readline().strip() == "ready"
@@ -45,11 +52,12 @@ def measure(roc: str, window: float, extra: list[str], env: dict[str, str], rate
         first = bw.stdout.readline()  # the subscription is matched and messages flow
         if not first:
             raise SystemExit(f"roc topic bw ended: {bw.stderr.read()}")
-        start, started = loopback_bytes(), time.monotonic()
+        start, started, first_count = loopback_bytes(), time.monotonic(), published()
         last = first
         while time.monotonic() - started < window:
             last = bw.stdout.readline()
-        wire = (loopback_bytes() - start) / (time.monotonic() - started)
+        sent, messages = loopback_bytes() - start, published() - first_count
+        wire = sent / (time.monotonic() - started)
     finally:
         stderr = ""
         if bw is not None:
@@ -57,7 +65,8 @@ def measure(roc: str, window: float, extra: list[str], env: dict[str, str], rate
             stderr = bw.communicate(timeout=20)[1]
         publisher.send_signal(signal.SIGINT)
         publisher.wait(timeout=20)
-    return {"wire_bytes_per_second": wire, "bw": json.loads(last), "stderr": stderr}
+    return {"wire_bytes_per_second": wire, "wire_bytes_per_message": sent / max(messages, 1), "published": messages,
+            "bw": json.loads(last), "stderr": stderr}
 
 
 def main() -> None:
