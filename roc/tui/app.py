@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 from textual.app import App
 from textual.binding import Binding
+from textual.screen import Screen
 
 from roc.errors import RocError, UsageError
 from roc.tui.feed import Feed
@@ -19,6 +20,8 @@ from roc.tui.palette import RocCommands, palette_lines
 from roc.tui.widgets import TextViewer, binding_lines
 
 if TYPE_CHECKING:  # builds load the engine's modules only when one starts
+    from textual.await_complete import AwaitComplete
+
     from roc.tui.build_run import BuildRun, Start
 
 
@@ -28,6 +31,7 @@ class RocApp(App[int]):
         Binding("q", "quit", "quit"),
         Binding("question_mark", "help", "help"),
         Binding("colon,ctrl+p", "command_palette", "commands"),
+        Binding("right_square_bracket", "forward", "forward again to the screen Esc left", show=False),
     ]
     COMMANDS = {RocCommands}
 
@@ -48,6 +52,7 @@ class RocApp(App[int]):
         self._first_build = build
         self.checks = checks
         self.bag = bag
+        self._forward: list[tuple[str, str]] = []  # (kind, name) of the screens Esc left, the last on top
 
     def on_mount(self) -> None:
         if self._first_build is not None:
@@ -62,11 +67,13 @@ class RocApp(App[int]):
             if self.bag:
                 self.open("bag", self.bag)
 
-    def open(self, kind: str, name: str = "") -> None:
+    def open(self, kind: str, name: str = "", forward: bool = False) -> None:
         """Push the screen of a node, topic, service or action (``name``), or a view of the palette
-        (roc.tui.palette.VIEWS: ``name`` holds its words)."""
+        (roc.tui.palette.VIEWS: ``name`` holds its words). Opening one forgets the screens Esc left,
+        as a browser does, unless it is one of them (``forward``)."""
         from roc.tui import call_screens
 
+        screen: Screen | None = None
         if kind in ("nodes", "topics", "services", "actions"):
             if self.graph_screen is not None:
                 while self.screen is not self.graph_screen and len(self.screen_stack) > 1:
@@ -75,15 +82,32 @@ class RocApp(App[int]):
         elif kind == "build":
             self.start_build([])
         elif kind in ("service", "action"):
-            screen = call_screens.ServiceScreen if kind == "service" else call_screens.ActionScreen
-            self.push_screen(screen(name, self.type_of(kind, name)))
+            call = call_screens.ServiceScreen if kind == "service" else call_screens.ActionScreen
+            screen = call(name, self.type_of(kind, name))
         elif kind == "publish":
-            self.push_screen(call_screens.PublishScreen(name, self.type_of("topic", name)))
+            screen = call_screens.PublishScreen(name, self.type_of("topic", name))
         else:
             try:
-                self.push_screen(self.view(kind, name))
+                screen = self.view(kind, name)
             except RocError as error:
                 self.notify(str(error), severity="error")
+        if not forward:
+            self._forward.clear()
+        if screen is not None:
+            screen.reopen = (kind, name)  # type: ignore[attr-defined]
+            self.push_screen(screen)
+
+    def pop_screen(self) -> AwaitComplete:
+        """Back (Esc): the screen left can be opened again with ``]``."""
+        reopen = getattr(self.screen, "reopen", None)
+        done = super().pop_screen()
+        if reopen is not None:
+            self._forward.append(reopen)
+        return done
+
+    def action_forward(self) -> None:
+        if self._forward:
+            self.open(*self._forward.pop(), forward=True)
 
     def view(self, kind: str, name: str):
         """The screen of a node or topic, or of a view that takes words (or none)."""

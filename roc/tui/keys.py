@@ -26,7 +26,8 @@ SCREENS = (
 # Textual's key names as the manual writes them
 NAMES = {"slash": "/", "question_mark": "?", "colon": ":", "escape": "Esc", "enter": "Enter", "tab": "Tab",
          "shift+tab": "Shift+Tab", "space": "Space", "plus": "+", "equals_sign": "=", "minus": "-",
-         "full_stop": ".", "greater_than_sign": ">", "less_than_sign": "<"}
+         "full_stop": ".", "greater_than_sign": ">", "less_than_sign": "<",
+         "right_square_bracket": "]"}
 
 
 def key_text(key: str) -> str:

@@ -210,4 +210,21 @@ def test_tab_keys_and_the_command_palette(graph) -> None:
             await palette_command(app, pilot, "node motor_con", "node /motor_controller")
             await until(pilot, lambda: type(app.screen).__name__ == "NodeScreen", what="the node, from the palette")
             assert app.screen.node == "/motor_controller"
+            # Esc back, ] forward again to the screen Esc left; opening another screen forgets it
+            await pilot.press("escape")
+            await until(pilot, lambda: app.screen is tabs, what="back")
+            await pilot.press("right_square_bracket")
+            await until(pilot, lambda: type(app.screen).__name__ == "NodeScreen", what="forward")
+            assert app.screen.node == "/motor_controller"
+            await pilot.press("escape")
+            await until(pilot, lambda: app.screen is tabs, what="back again")
+            await palette_command(app, pilot, "diagnostics", "diagnostics")
+            await until(pilot, lambda: type(app.screen).__name__ == "DiagnosticsScreen", what="the diagnostics")
+            await pilot.press("escape")
+            await until(pilot, lambda: app.screen is tabs, what="back from the diagnostics")
+            await pilot.press("right_square_bracket")
+            await until(pilot, lambda: type(app.screen).__name__ == "DiagnosticsScreen", what="forward to the last left")
+            await pilot.press("escape")
+            await until(pilot, lambda: app.screen is tabs, what="back to the lists")
+            assert [kind for kind, _ in app._forward] == ["diagnostics"]  # the node was forgotten
     drive(test)
