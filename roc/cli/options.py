@@ -153,7 +153,8 @@ def add_discovery_arguments(parser: argparse.ArgumentParser) -> None:
                         help="without the daemon: how long at most to discover the graph (discovery ends "
                              "sooner, once every participant of this host has been heard and the graph is "
                              "quiet); for topic streams, also how long a topic's publishers may take to "
-                             "appear (default: 3.5, one DDS announcement period)")
+                             "appear (default: 3.5, one DDS announcement period, and up to 3 s more while "
+                             "the graph is known to be incomplete)")
 
 
 QOS_PROFILES = ("unknown", "default", "system_default", "sensor_data", "services_default", "parameters",

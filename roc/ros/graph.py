@@ -51,10 +51,12 @@ from roc.ros.type_description import describe
 # QUIET_SECONDS (LOCAL_QUIET_SECONDS when discovery stays on this host: nothing is left to hear then but
 # the rest of a participant's endpoints); at the latest after the period (``--spin-time``, default
 # DEFAULT_SPIN_TIME, in roc.ros.protocol so that verbs can read it without rclpy: one Fast DDS
-# announcement period and a margin, all a participant could wait before). Measured with ten processes:
+# announcement period and a margin, all a participant could wait before; without --spin-time, one more
+# announcement period while the graph is known to be incomplete). Measured with ten processes:
 # complete in 20 of 20 runs, where a fixed 3.5 s was needed before.
 QUIET_SECONDS = 0.3
 LOCAL_QUIET_SECONDS = 0.1
+ANNOUNCEMENT_SECONDS = 3.0  # Fast DDS's default period of a participant's announcements
 POLL_SECONDS = 0.05
 SERVICE_TIMEOUT = 5.0
 SPIN_SLICE = 0.1  # seconds an executor waits before it looks whether the graph is closing
@@ -202,10 +204,16 @@ class Graph:
                       for n, t in sorted(node.get_topic_names_and_types())),
                 tuple((n, tuple(t)) for n, t in sorted(node.get_service_names_and_types())))
 
-    def wait_for_discovery(self, period: float = DEFAULT_SPIN_TIME) -> None:
+    def wait_for_discovery(self, period: float | None = None) -> None:
         """Return once this host's participants are discovered, every endpoint's node is known and the
-        graph has been unchanged for a quiet time; at the latest after ``period`` (see QUIET_SECONDS)."""
+        graph has been unchanged for a quiet time (see QUIET_SECONDS); at the latest after ``period``.
+        Without one, after DEFAULT_SPIN_TIME, or, while the graph is known to be incomplete (a
+        participant of this host not heard yet, an endpoint's node not told yet), one more
+        announcement period (ANNOUNCEMENT_SECONDS): what a process heard only at its next periodic
+        announcement needs on a loaded machine."""
         quiet = LOCAL_QUIET_SECONDS if discovery_stays_local() else QUIET_SECONDS
+        bound = DEFAULT_SPIN_TIME if period is None else period
+        longest = bound + ANNOUNCEMENT_SECONDS if period is None else period
         domain = self.context.get_domain_id()
         start = last_change = time.monotonic()
         last = self.signature()
@@ -215,20 +223,24 @@ class Graph:
             current = self.signature()
             if current != last:
                 last, last_change = current, now
-            elif now - last_change >= quiet and self._local_peers_discovered(domain) and self._complete():
-                return
-            if now - start >= period:
+            elapsed = now - start
+            if now - last_change < quiet and elapsed < bound:
+                continue
+            peers = self._local_peers_discovered(domain)
+            complete = peers is not False and self._complete()
+            if (complete and peers and now - last_change >= quiet) or elapsed >= longest or (
+                    complete and elapsed >= bound):
                 return
 
-    def _local_peers_discovered(self, domain: int) -> bool:
-        """Every participant of another process on this host in ``domain`` has been discovered (False
+    def _local_peers_discovered(self, domain: int) -> bool | None:
+        """Every participant of another process on this host in ``domain`` has been discovered (None
         when that cannot be told: the wait then lasts its whole period)."""
         expected = local_participant_count(domain)
-        if expected is None:
-            return False
         writers = self.node.get_publishers_info_by_topic(DISCOVERY_TOPIC, no_mangle=True)
         discovered = discovered_local_peers(writers, os.getpid())
-        return discovered is not None and discovered >= expected
+        if expected is None or discovered is None:
+            return None
+        return discovered >= expected
 
     def _complete(self) -> bool:
         """Every endpoint's node is known (a participant seen before its node names is not complete), and

@@ -7,15 +7,16 @@ from __future__ import annotations
 from typing import Any
 
 from roc.ros.graph import Graph
-from roc.ros.protocol import DEFAULT_SPIN_TIME, Events
+from roc.ros.protocol import Events
 from roc.ros.streams import run_on
 
 
 def discovered_graph(spin_time: float | None = None, node_name: str | None = None) -> Graph:
-    """A fresh participant that has waited for discovery (``spin_time``, default DEFAULT_SPIN_TIME)."""
+    """A fresh participant that has waited for discovery (at most ``spin_time``; see
+    Graph.wait_for_discovery for the default)."""
     graph = Graph(node_name)
     try:
-        graph.wait_for_discovery(spin_time if spin_time is not None else DEFAULT_SPIN_TIME)
+        graph.wait_for_discovery(spin_time)
     except BaseException:
         graph.close()
         raise

@@ -142,7 +142,7 @@ class FakeClock:
 
 class FakeGraph:
     """Stands in for roc.ros.graph.Graph: its signature changes until ``settles_at``, this host's other
-    participants are all discovered from ``peers_at`` (never when None)."""
+    participants are all discovered from ``peers_at`` (never when None; "uncountable": cannot be told)."""
 
     def __init__(self, clock: FakeClock, settles_at: float, peers_at: float | None):
         self.clock, self.settles_at, self.peers_at = clock, settles_at, peers_at
@@ -153,7 +153,9 @@ class FakeGraph:
     def _complete(self):
         return True
 
-    def _local_peers_discovered(self, domain: int) -> bool:
+    def _local_peers_discovered(self, domain: int) -> bool | None:
+        if self.peers_at == "uncountable":
+            return None
         return self.peers_at is not None and self.clock.now >= self.peers_at
 
 
@@ -163,6 +165,10 @@ class FakeGraph:
     (0.0, 1.2, 3.5, 1.2),  # a participant of this host not heard yet: waits for it
     (0.0, None, 3.5, 3.5),  # one never heard (or not countable): the whole period (--spin-time)
     (60.0, 0.0, 2.0, 2.0),  # never quiet: the period
+    (0.0, None, None, 6.5),  # without --spin-time, one known unheard: one more announcement period
+    (0.0, 5.0, None, 5.0),  # ... ending when it is heard
+    (0.0, "uncountable", None, 3.5),  # the default period when who is missing cannot be told
+    (60.0, 0.0, None, 3.5),  # never quiet but complete: the default period
 ])
 def test_discovery_ends_when_this_hosts_participants_are_heard_and_the_graph_is_quiet(
         monkeypatch, settles_at, peers_at, period, ends_at):
