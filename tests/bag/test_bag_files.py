@@ -297,6 +297,7 @@ def test_reindex_rebuilds_metadata_of_reference_bags(rosbag2_reference, tmp_path
                                                      for i in range(3)]
 
 
+@pytest.mark.slow  # over a second (the quick loop stays under 45 s)
 def test_unclosed_mcap_file_is_read_and_reindex_repairs_it(tmp_path):
     """A recording killed mid-way: the file has whole chunks and a cut one, no summary, no metadata.yaml."""
     from mcap.reader import make_reader
@@ -442,6 +443,7 @@ def test_interface_show_from_a_bag_matches_the_installed_definition(tmp_path: Pa
         assert "\tbool bool_value" in from_bag.stdout  # BasicTypes, from the bag's MSG: section
 
 
+@pytest.mark.slow  # over a second (the quick loop stays under 45 s)
 def test_interface_show_of_a_type_only_a_bag_knows(tmp_path: Path) -> None:
     from roc.bag.definitions import DELIMITER
     from roc.bag.message import Definition

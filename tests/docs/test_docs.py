@@ -37,6 +37,7 @@ def _mkdocs_build(root: Path, site: Path) -> subprocess.CompletedProcess:
                           env=env, capture_output=True, text=True, timeout=300)
 
 
+@pytest.mark.slow  # a few seconds (the quick loop stays under 45 s)
 def test_the_manual_builds_with_warnings_as_errors(tmp_path: Path) -> None:
     result = _mkdocs_build(REPO, tmp_path / "site")
     assert result.returncode == 0, result.stdout + result.stderr
@@ -47,6 +48,7 @@ def test_the_manual_builds_with_warnings_as_errors(tmp_path: Path) -> None:
     assert not (tmp_path / "site" / "hooks").exists()
 
 
+@pytest.mark.slow  # a few seconds (the quick loop stays under 45 s)
 def test_a_broken_link_or_a_page_outside_the_nav_fails_the_build(tmp_path: Path) -> None:
     shutil.copytree(REPO / "docs", tmp_path / "docs")
     shutil.copy(REPO / "mkdocs.yml", tmp_path)

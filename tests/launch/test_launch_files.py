@@ -98,6 +98,7 @@ def test_roc_and_ros2_launch_start_the_same_system(demo, tmp_path: Path, file: s
     assert "[talker-1] [INFO] [" in outputs["roc"]  # the processes' output, prefixed as ros2 launch does
 
 
+@pytest.mark.slow  # over a second (the quick loop stays under 45 s)
 @pytest.mark.parametrize("file", [FORMATS[0], *(pytest.param(f, marks=pytest.mark.slow) for f in FORMATS[1:])])
 def test_show_args_prints_what_ros2_launch_prints(demo, file: str) -> None:
     env, _ = demo
@@ -138,6 +139,7 @@ def test_a_missing_file_or_package_is_one_line_listing_what_exists(demo, tmp_pat
     assert nothing.returncode == 2 and "'no_such_system' is not a launch file, and no roc.toml here" in nothing.stderr
 
 
+@pytest.mark.slow  # over a second (the quick loop stays under 45 s)
 def test_a_broken_launch_file_fails_as_in_ros2_launch(demo, tmp_path: Path) -> None:
     env, _ = demo
     broken = tmp_path / "broken.launch.py"

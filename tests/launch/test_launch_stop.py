@@ -167,6 +167,7 @@ def test_check_then_exit_is_a_launch_smoke_test(demo, tmp_path: Path, green: boo
         assert "Finished <<< node /robot1/talker" in output
 
 
+@pytest.mark.slow  # over a second (the quick loop stays under 45 s)
 def test_a_bad_check_file_stops_before_anything_starts(demo, tmp_path: Path) -> None:
     env, prefix = demo
     check = tmp_path / "expected.toml"
@@ -234,6 +235,7 @@ def generate_launch_description():
 """
 
 
+@pytest.mark.slow  # over a second (the quick loop stays under 45 s)
 def test_a_second_ctrl_c_kills_every_process_at_once(demo, tmp_path: Path) -> None:
     env, _ = demo
     script = tmp_path / "stubborn.sh"  # ignores SIGINT: the library would wait 5 s before its SIGTERM

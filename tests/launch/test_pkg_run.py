@@ -71,6 +71,7 @@ def test_pkg_errors_are_one_line(demo) -> None:
         in no_tag.stderr
 
 
+@pytest.mark.slow  # over a second (the quick loop stays under 45 s)
 def test_run_passes_arguments_untouched_and_the_exit_code_back(demo) -> None:
     env, _ = demo
     words = ["a", "b c", "--ros-args", "-p", "x:=1", "--debug", "-r", "__node:=n"]

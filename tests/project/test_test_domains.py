@@ -48,6 +48,7 @@ def test_no_test_hard_codes_a_domain():
     assert not shared, f"domain slots used by several test files: {shared}"
 
 
+@pytest.mark.slow  # a few seconds (the quick loop stays under 45 s)
 def test_an_xdist_group_runs_on_one_worker(tmp_path):
     """scripts/test.sh's --dist loadgroup keeps the tests of an xdist_group on one worker (the bridge
     tests' busy processes apart from timing tests; each ported ros2cli file's graph started once). A

@@ -6,6 +6,7 @@ from __future__ import annotations
 import asyncio
 from typing import Any
 
+import pytest
 from helpers.tui import SIZE, table, until
 from textual.widgets import TabbedContent
 
@@ -36,6 +37,7 @@ class DataFeed(Feed):
         return iter(())
 
 
+@pytest.mark.slow  # a few seconds (the quick loop stays under 45 s)
 def test_a_tab_chosen_keeps_its_list_focused() -> None:
     """A click on a tab switches it without the key's own focus: the list that loses its tab must not
     hand the focus to its sibling (nodes beside topics), which would bring the first tab back."""
