@@ -175,6 +175,20 @@ def screen_name(app) -> str:
     return type(app.screen).__name__
 
 
+def launch_rows(app) -> dict[str, object]:
+    """The launches view's rows by process name."""
+    return {row.cells[0]: row for row in table(app, "#processes").rows_by_key.values()}
+
+
+async def open_launches(app, pilot, processes: set[str]) -> None:
+    """The launches view, once it shows ``processes`` running."""
+    app.open("launch")
+    await until(pilot, lambda: screen_name(app) == "LaunchScreen" and bool(app.screen.query("#processes")),
+                what="the launch view")
+    await until(pilot, lambda: processes <= set(launch_rows(app))
+                and all(launch_rows(app)[p].cells[3] == "running" for p in processes), what="the run")
+
+
 IMAGES = REPO / "docs" / "images"
 
 

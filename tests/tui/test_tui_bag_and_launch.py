@@ -13,7 +13,7 @@ from helpers.build import BIN
 from helpers.graph import read_line, stop_all
 from helpers.launch import demo_env, roc_launch
 from helpers.oracles import SHARED
-from helpers.tui import live_graph, picture, screen_name, table, until
+from helpers.tui import launch_rows, live_graph, open_launches, picture, screen_name, table, until
 
 from roc.tui.app import RocApp
 
@@ -82,15 +82,10 @@ def test_a_launch_run_shown_restarted_and_stopped(tmp_path, launch_demo_prefix) 
             async def test() -> None:
                 app = RocApp()
                 async with app.run_test(size=(100, 30)) as pilot:
-                    app.open("launch")
-                    await until(pilot, lambda: screen_name(app) == "LaunchScreen" and app.screen.query("#processes"),
-                                what="the launch view")
-                    rows = lambda: {r.cells[0]: r for r in table(app, "#processes").rows_by_key.values()}  # noqa: E731
-                    await until(pilot, lambda: {"talker", "listener"} <= set(rows())
-                                and all(r.cells[3] == "running" for r in rows().values()), what="the run")
-                    talker_pid = rows()["talker"].cells[2]
+                    await open_launches(app, pilot, {"talker", "listener"})
+                    talker_pid = launch_rows(app)["talker"].cells[2]
                     picture(app, "launch")
-                    assert rows()["talker"].cells[1] == f"roc launch pair [{launcher.pid}]"
+                    assert launch_rows(app)["talker"].cells[1] == f"roc launch pair [{launcher.pid}]"
                     processes = table(app, "#processes")
                     processes.select(next(k for k, r in processes.rows_by_key.items() if r.cells[0] == "listener"))
                     await pilot.press("enter")
@@ -100,11 +95,11 @@ def test_a_launch_run_shown_restarted_and_stopped(tmp_path, launch_demo_prefix) 
                     await pilot.press("escape")
                     processes.select(next(k for k, r in processes.rows_by_key.items() if r.cells[0] == "talker"))
                     await pilot.press("R")
-                    await until(pilot, lambda: rows()["talker"].cells[4] == "1" and rows()["talker"].cells[2] != talker_pid
-                                and rows()["talker"].cells[3] == "running", what="the talker restarted")
+                    await until(pilot, lambda: launch_rows(app)["talker"].cells[4] == "1" and launch_rows(app)["talker"].cells[2] != talker_pid
+                                and launch_rows(app)["talker"].cells[3] == "running", what="the talker restarted")
                     processes.select(next(k for k, r in processes.rows_by_key.items() if r.cells[0] == "listener"))
                     await pilot.press("s")
-                    await until(pilot, lambda: rows()["listener"].cells[3] != "running", what="the listener stopped")
+                    await until(pilot, lambda: launch_rows(app)["listener"].cells[3] != "running", what="the listener stopped")
             asyncio.run(test())
         assert "talker: restart asked by roc tui" in launcher.output()
     finally:

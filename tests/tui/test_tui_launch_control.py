@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 from helpers.launch import demo_env, roc_launch, skip_without_launch_library
-from helpers.tui import live_graph, screen_name, table, text_of, until, until_screen
+from helpers.tui import launch_rows, live_graph, open_launches, table, text_of, until, until_screen
 
 from roc.tui.app import RocApp
 
@@ -45,10 +45,6 @@ def sleeper_prefix(root: Path) -> Path:
     return root
 
 
-def launch_rows(app) -> dict[str, object]:
-    return {row.cells[0]: row for row in table(app, "#processes").rows_by_key.values()}
-
-
 async def stop_from_the_view(app, pilot, process: str, last: bool = False) -> None:
     """``s`` on the process; then it is shown stopped (the ``last`` one of a run ends the run)."""
     processes = table(app, "#processes")
@@ -57,14 +53,6 @@ async def stop_from_the_view(app, pilot, process: str, last: bool = False) -> No
     if not last:
         await until_screen(app, pilot, lambda _: launch_rows(app)[process].cells[3].startswith("stopped"),
                            f"{process} stopped")
-
-
-async def open_launches(app, pilot, processes: set[str]) -> None:
-    app.open("launch")
-    await until(pilot, lambda: screen_name(app) == "LaunchScreen" and bool(app.screen.query("#processes")),
-                what="the launch view")
-    await until(pilot, lambda: processes <= set(launch_rows(app))
-                and all(launch_rows(app)[p].cells[3] == "running" for p in processes), what="the run")
 
 
 def test_a_process_stopped_on_purpose_is_not_respawned_nor_a_failure(tmp_path, launch_demo_prefix) -> None:
