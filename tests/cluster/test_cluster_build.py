@@ -26,8 +26,12 @@ from helpers.cluster import (
     kill_processes,
     scheduler_workers,
     sitecustomize_audit,
+    start_scheduler,
+    start_worker,
+    stop_all,
     tls_client_environment,
     tls_files,
+    wait_for_workers,
     worker_process,
 )
 from helpers.remote_servers import free_port, webdav
@@ -336,3 +340,31 @@ def test_a_tls_cluster_builds_and_refuses_a_client_without_its_certificate(dav, 
     assert plain.returncode == 1, plain.stdout + plain.stderr
     assert plain.stderr.startswith(f"roc: error: cannot reach the Dask scheduler at {address}"), plain.stderr
     assert plain.stderr.count("\n") == 1
+
+
+def test_a_worker_out_of_disk_fails_the_package_with_the_reason(dav, tmp_path):
+    """The only worker's root is on a full file system (a 64 kB tmpfs in a mount namespace of its own):
+    the package fails as a local build that ran out of disk does, its output saying "No space left on
+    device", with no traceback and nothing restored here."""
+    env = ros_env()
+    root = tmp_path / "small disk" / "root"
+    root.mkdir(parents=True)
+    mount = ("unshare", "-m", "--propagation", "private", "sh", "-c",
+             'mount -t tmpfs -o size=64k tmpfs "$0" && exec "$@"', str(root))
+    if shutil.which("unshare") is None or subprocess.run([*mount, "true"], capture_output=True).returncode:
+        pytest.skip("a file system of its own (a tmpfs in a mount namespace) needs root")
+    scheduler, address = start_scheduler(tmp_path / "scheduler", env)
+    worker = start_worker(address, root, "worker-full", env, prefix=mount)
+    try:
+        wait_for_workers(address, {"worker-full"}, env, [worker])
+        ws = _checkout(tmp_path, "client")
+        result = roc("work", "build", "--cluster", address, "--remote-cache", f"{dav}-full", "--packages-select",
+                     "dia_a", cwd=ws, env=env, timeout=300)
+        output = result.stdout + result.stderr
+        assert result.returncode == 1, output
+        assert "No space left on device" in output, output
+        assert "Traceback" not in output
+        assert re.search(r"^Failed   <<< dia_a \[[\d.]+s, CMake configure failed\]$", result.stdout, re.M), output
+        assert not (ws / "install" / "dia_a").exists(), "nothing restored of a package that failed"
+    finally:
+        stop_all([worker, scheduler])
