@@ -6,7 +6,7 @@ import json
 from pathlib import Path
 
 import pytest
-from helpers.build import copy_fixture, roc, ros_env
+from helpers.build import add_plain_package, copy_fixture, roc, ros_env
 
 
 @pytest.fixture
@@ -153,19 +153,8 @@ def test_roc_toml_mistakes_name_the_line_and_the_closest_name(toml: str, message
     assert len(lines) == 1 and message in lines[0], result.stderr
 
 
-def _plain(ws, name: str, text: str = "v1", depends: str = "") -> None:
-    directory = ws / "src" / name
-    directory.mkdir(parents=True, exist_ok=True)
-    (directory / "value.txt").write_text(text)
-    (directory / "CMakeLists.txt").write_text(
-        f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n{depends}"
-        f"install(FILES value.txt DESTINATION share/{name})\n"
-        f"file(WRITE ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake \"\")\n"
-        f"install(FILES ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake DESTINATION share/{name}/cmake)\n")
-
-
 def test_colcon_meta_values_are_type_checked(tmp_path):
-    _plain(tmp_path, "alpha")
+    add_plain_package(tmp_path, "alpha")
     (tmp_path / "colcon.meta").write_text('{"names": {"alpha": {"cmake-args": "-DX=1"}}}')
     result = roc("work", "build", cwd=tmp_path)
     assert result.returncode == 2 and "colcon.meta" in result.stderr and "list of strings" in result.stderr

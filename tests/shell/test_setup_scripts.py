@@ -8,23 +8,12 @@ import stat
 import subprocess
 
 import pytest
-from helpers.build import roc
-
-
-def _plain(ws, name: str, text: str = "v1", depends: str = "") -> None:
-    directory = ws / "src" / name
-    directory.mkdir(parents=True, exist_ok=True)
-    (directory / "value.txt").write_text(text)
-    (directory / "CMakeLists.txt").write_text(
-        f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n{depends}"
-        f"install(FILES value.txt DESTINATION share/{name})\n"
-        f"file(WRITE ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake \"\")\n"
-        f"install(FILES ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake DESTINATION share/{name}/cmake)\n")
+from helpers.build import add_plain_package, roc
 
 
 @pytest.mark.slow
 def test_generated_files_are_readable_by_others(tmp_path):
-    _plain(tmp_path, "alpha")
+    add_plain_package(tmp_path, "alpha")
     assert roc("work", "build", cwd=tmp_path).returncode == 0
     for path in (tmp_path / "install" / "setup.sh", tmp_path / "install" / "alpha" / "share" / "alpha" / "package.sh"):
         assert stat.S_IMODE(path.stat().st_mode) & 0o044 == 0o044, path
@@ -33,7 +22,7 @@ def test_generated_files_are_readable_by_others(tmp_path):
 @pytest.mark.slow
 def test_posix_sh_with_spaces_and_non_ascii_in_the_path(tmp_path):
     ws = tmp_path / "my wörk $space"
-    _plain(ws, "alpha")
+    add_plain_package(ws, "alpha")
     assert roc("work", "build", cwd=ws).returncode == 0
     result = subprocess.run(["sh", "-c", f'. {shlex.quote(str(ws))}/install/setup.sh; echo "$CMAKE_PREFIX_PATH"'],
                             cwd=tmp_path,

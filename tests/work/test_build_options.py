@@ -7,7 +7,7 @@ import shutil
 from pathlib import Path
 
 import pytest
-from helpers.build import BIN, roc, ros_env
+from helpers.build import BIN, add_plain_package, roc, ros_env
 
 pytestmark = pytest.mark.slow  # every test builds a workspace
 
@@ -132,24 +132,13 @@ def test_cmake_generator_is_respected(tmp_path):
     assert (ws / "install" / "alpha" / "share" / "alpha" / "CMakeLists.txt").is_file()
 
 
-def _plain(ws, name: str, text: str = "v1", depends: str = "") -> None:
-    directory = ws / "src" / name
-    directory.mkdir(parents=True, exist_ok=True)
-    (directory / "value.txt").write_text(text)
-    (directory / "CMakeLists.txt").write_text(
-        f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n{depends}"
-        f"install(FILES value.txt DESTINATION share/{name})\n"
-        f"file(WRITE ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake \"\")\n"
-        f"install(FILES ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake DESTINATION share/{name}/cmake)\n")
-
-
 @pytest.mark.parametrize("args, words", [
     (["--build-base", "afile"], ["afile"]),
     (["-j", "0"], ["-j"]),
     (["--log-base", "afile"], ["afile"]),
 ])
 def test_bad_bases_and_numbers_are_one_line_errors(tmp_path, args, words):
-    _plain(tmp_path, "alpha")
+    add_plain_package(tmp_path, "alpha")
     (tmp_path / "afile").write_text("")
     result = roc("work", "build", *args, cwd=tmp_path)
     assert result.returncode in (1, 2)
@@ -159,15 +148,15 @@ def test_bad_bases_and_numbers_are_one_line_errors(tmp_path, args, words):
 
 @pytest.mark.slow
 def test_not_processed_packages_are_counted(tmp_path):
-    _plain(tmp_path, "a")
+    add_plain_package(tmp_path, "a")
     (tmp_path / "src" / "a" / "CMakeLists.txt").write_text("message(FATAL_ERROR no)\n")
-    _plain(tmp_path, "b", depends="find_package(a)\n")
+    add_plain_package(tmp_path, "b", depends="find_package(a)\n")
     result = roc("work", "build", cwd=tmp_path)
     assert result.returncode == 1 and "1 package not processed" in result.stdout
 
 
 def test_command_line_cmake_args_replace_configured_ones(tmp_path):
-    _plain(tmp_path, "alpha")
+    add_plain_package(tmp_path, "alpha")
     (tmp_path / "roc.toml").write_text('[build]\ncmake-args = ["-DFROM_TOML=1"]\n')
     assert roc("work", "build", "--cmake-args", "-DFROM_CLI=1", cwd=tmp_path).returncode == 0
     log = (tmp_path / "log" / "latest_build" / "alpha" / "command.log").read_text()

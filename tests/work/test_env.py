@@ -7,7 +7,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from helpers.build import roc, ros_env
+from helpers.build import add_plain_package, roc, ros_env
 
 
 def _plain_cmake(workspace: Path, name: str, depends: str = "") -> None:
@@ -47,19 +47,8 @@ def test_env_prints_only_what_the_build_environment_changes(tmp_path: Path) -> N
     assert evaluated.stdout.strip() == f"{str(tmp_path / 'install' / 'alpha')}|{env['PATH']}"
 
 
-def _plain(ws, name: str, text: str = "v1", depends: str = "") -> None:
-    directory = ws / "src" / name
-    directory.mkdir(parents=True, exist_ok=True)
-    (directory / "value.txt").write_text(text)
-    (directory / "CMakeLists.txt").write_text(
-        f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n{depends}"
-        f"install(FILES value.txt DESTINATION share/{name})\n"
-        f"file(WRITE ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake \"\")\n"
-        f"install(FILES ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake DESTINATION share/{name}/cmake)\n")
-
-
 def test_env_output_can_be_evaluated_with_exported_functions(tmp_path):
-    _plain(tmp_path, "alpha")
+    add_plain_package(tmp_path, "alpha")
     assert roc("work", "build", cwd=tmp_path).returncode == 0
     env = {**ros_env(), "BASH_FUNC_f%%": "() {  :\n}"}
     printed = roc("work", "env", "alpha", "--all", cwd=tmp_path, env=env)

@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 
 import pytest
-from helpers.build import BIN, in_sourced_shell, roc, ros_env
+from helpers.build import BIN, add_plain_package, in_sourced_shell, roc, ros_env
 
 pytestmark = pytest.mark.slow
 
@@ -130,22 +130,11 @@ def test_a_rebuild_for_another_cc_compiles_with_it(ws: Path, tmp_path: Path) -> 
     assert marker.exists()
 
 
-def _plain(ws, name: str, text: str = "v1", depends: str = "") -> None:
-    directory = ws / "src" / name
-    directory.mkdir(parents=True, exist_ok=True)
-    (directory / "value.txt").write_text(text)
-    (directory / "CMakeLists.txt").write_text(
-        f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n{depends}"
-        f"install(FILES value.txt DESTINATION share/{name})\n"
-        f"file(WRITE ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake \"\")\n"
-        f"install(FILES ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake DESTINATION share/{name}/cmake)\n")
-
-
 @pytest.mark.slow
 def test_changed_underlay_rebuilds_the_overlay(tmp_path):
     underlay, overlay = tmp_path / "underlay", tmp_path / "overlay"
-    _plain(underlay, "lib_a")
-    _plain(overlay, "app_b", depends="find_package(lib_a REQUIRED)\n")
+    add_plain_package(underlay, "lib_a")
+    add_plain_package(overlay, "app_b", depends="find_package(lib_a REQUIRED)\n")
     assert roc("work", "build", cwd=underlay).returncode == 0
     build = f"source {underlay}/install/setup.bash && {BIN}/roc work build"
     assert in_sourced_shell(overlay, build, setup="/dev/null", strict=False).returncode == 0
@@ -162,7 +151,7 @@ def test_changed_underlay_rebuilds_the_overlay(tmp_path):
 def test_symlinked_sources_are_tracked(tmp_path):
     shared = tmp_path / "shared.txt"
     shared.write_text("v1")
-    _plain(tmp_path / "ws", "alpha")
+    add_plain_package(tmp_path / "ws", "alpha")
     value = tmp_path / "ws" / "src" / "alpha" / "value.txt"
     value.unlink()
     value.symlink_to(shared)

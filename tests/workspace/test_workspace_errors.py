@@ -8,7 +8,7 @@ import re
 from pathlib import Path
 
 import pytest
-from helpers.build import copy_fixture, roc
+from helpers.build import add_plain_package, copy_fixture, roc
 from helpers.fixture_workspaces import run_roc
 
 # fixture -> (file named in the message, what the message must also say)
@@ -136,17 +136,6 @@ def test_info_without_packages_fails_as_in_colcon(tmp_path: Path) -> None:
     assert run_roc("work", "list", cwd=tmp_path / "ws").returncode == 0  # list and graph print nothing, as colcon
 
 
-def _plain(ws, name: str, text: str = "v1", depends: str = "") -> None:
-    directory = ws / "src" / name
-    directory.mkdir(parents=True, exist_ok=True)
-    (directory / "value.txt").write_text(text)
-    (directory / "CMakeLists.txt").write_text(
-        f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n{depends}"
-        f"install(FILES value.txt DESTINATION share/{name})\n"
-        f"file(WRITE ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake \"\")\n"
-        f"install(FILES ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake DESTINATION share/{name}/cmake)\n")
-
-
 def test_unusable_package_name_is_an_error(tmp_path):
     (tmp_path / "src" / "weird").mkdir(parents=True)
     (tmp_path / "src" / "weird" / "colcon.pkg").write_text(json.dumps({"name": "we$(touch PWNED)ird",
@@ -163,7 +152,7 @@ def test_unsupported_build_type_is_skipped_with_a_warning(tmp_path):
         '<package format="3"><name>rusty</name><version>1.0.0</version><description>d</description>'
         '<maintainer email="m@example.com">m</maintainer><license>MIT</license>'
         "<export><build_type>ament_cargo</build_type></export></package>")
-    _plain(tmp_path, "alpha")
+    add_plain_package(tmp_path, "alpha")
     result = roc("work", "build", cwd=tmp_path)
     assert result.returncode == 0 and "'ros.ament_cargo'" in result.stderr and "skipped" in result.stderr
     assert "Finished <<< alpha" in result.stdout
