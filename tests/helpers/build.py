@@ -55,15 +55,18 @@ def without_suite_compiler_cache(env: dict[str, str]) -> dict[str, str]:
     return {name: value for name, value in env.items() if name not in SUITE_COMPILER_CACHE}
 
 
-def add_plain_package(ws, name: str, text: str = "v1", depends: str = "") -> None:
-    """A plain CMake package ``src/NAME`` (no package.xml) that installs ``value.txt`` holding ``text``
-    and a config file ``find_package`` finds; ``depends``: CMake lines before the installs."""
+def add_plain_package(ws, name: str, text: str | None = "v1", depends: str = "") -> None:
+    """A plain CMake package ``src/NAME`` (no package.xml) with a config file ``find_package`` finds,
+    installing ``value.txt`` holding ``text`` (none when None); ``depends``: CMake lines before the
+    installs."""
     directory = ws / "src" / name
     directory.mkdir(parents=True, exist_ok=True)
-    (directory / "value.txt").write_text(text)
+    value = ""
+    if text is not None:
+        (directory / "value.txt").write_text(text)
+        value = f"install(FILES value.txt DESTINATION share/{name})\n"
     (directory / "CMakeLists.txt").write_text(
-        f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n{depends}"
-        f"install(FILES value.txt DESTINATION share/{name})\n"
+        f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n{depends}{value}"
         f"file(WRITE ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake \"\")\n"
         f"install(FILES ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake DESTINATION share/{name}/cmake)\n")
 

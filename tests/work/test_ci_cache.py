@@ -7,7 +7,7 @@ import shutil
 from pathlib import Path
 
 import pytest
-from helpers.build import FIXTURES, copy_fixture, in_sourced_shell, roc
+from helpers.build import FIXTURES, add_plain_package, copy_fixture, in_sourced_shell, roc
 
 pytestmark = pytest.mark.slow
 
@@ -84,25 +84,16 @@ def test_bad_usage(tmp_path):
     assert not_a_cache.returncode == 1 and "not a usable roc cache" in not_a_cache.stderr
 
 
-def _plain_cmake(workspace: Path, name: str, depends: str = "") -> None:
-    directory = workspace / "src" / name
-    directory.mkdir(parents=True)
-    (directory / "CMakeLists.txt").write_text(
-        f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n{depends}"
-        f"file(WRITE ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake \"\")\n"
-        f"install(FILES ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake DESTINATION share/{name}/cmake)\n")
-
-
 @pytest.mark.slow
 def test_cache_export_says_what_it_left_out_and_why(tmp_path: Path) -> None:
     workspace = tmp_path / "ws"
-    _plain_cmake(workspace, "alpha")
-    _plain_cmake(workspace, "beta", "find_package(alpha REQUIRED)\n")
-    _plain_cmake(workspace, "fixed")
+    add_plain_package(workspace, "alpha", None)
+    add_plain_package(workspace, "beta", None, "find_package(alpha REQUIRED)\n")
+    add_plain_package(workspace, "fixed", None)
     with (workspace / "src" / "fixed" / "CMakeLists.txt").open("a") as cmake:
         cmake.write('file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/where.txt "${CMAKE_INSTALL_PREFIX}")\n'
                     "install(FILES ${CMAKE_CURRENT_BINARY_DIR}/where.txt DESTINATION share/fixed)\n")
-    _plain_cmake(workspace, "never_built")
+    add_plain_package(workspace, "never_built", None)
     built = roc("work", "build", "--packages-skip", "never_built", cwd=workspace)
     assert built.returncode == 0, built.stdout + built.stderr
     with (workspace / "src" / "alpha" / "CMakeLists.txt").open("a") as cmake:

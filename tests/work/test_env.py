@@ -10,15 +10,6 @@ import pytest
 from helpers.build import add_plain_package, roc, ros_env
 
 
-def _plain_cmake(workspace: Path, name: str, depends: str = "") -> None:
-    directory = workspace / "src" / name
-    directory.mkdir(parents=True)
-    (directory / "CMakeLists.txt").write_text(
-        f"cmake_minimum_required(VERSION 3.8)\nproject({name} NONE)\n{depends}"
-        f"file(WRITE ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake \"\")\n"
-        f"install(FILES ${{CMAKE_CURRENT_BINARY_DIR}}/{name}Config.cmake DESTINATION share/{name}/cmake)\n")
-
-
 def test_env_without_a_package_is_a_clear_usage_error(tmp_path: Path) -> None:
     result = roc("work", "env", cwd=tmp_path)
     assert result.returncode == 2
@@ -28,8 +19,8 @@ def test_env_without_a_package_is_a_clear_usage_error(tmp_path: Path) -> None:
 
 @pytest.mark.slow
 def test_env_prints_only_what_the_build_environment_changes(tmp_path: Path) -> None:
-    _plain_cmake(tmp_path, "alpha")
-    _plain_cmake(tmp_path, "beta", "find_package(alpha REQUIRED)\n")
+    add_plain_package(tmp_path, "alpha", None)
+    add_plain_package(tmp_path, "beta", None, "find_package(alpha REQUIRED)\n")
     env = ros_env(OLDPWD="/somewhere/else", ROC_TEST_UNRELATED="1")
     assert roc("work", "build", cwd=tmp_path, env=env).returncode == 0
     env["OLDPWD"] = "/another/place"  # differs from the saved build environment: still not printed
