@@ -159,17 +159,32 @@ def test_ctrl_c_leaves_no_subscription_in_the_daemon(graph) -> None:
     assert subscribers() == before
 
 
-def _run_for(seconds: float, *args: str, env: dict[str, str]) -> tuple[int, str, str]:
-    """A streaming roc command interrupted (SIGINT, as Ctrl+C) after ``seconds``."""
+def _run_until(*args: str, lines: int, env: dict[str, str],
+               topics: tuple[str, ...] = ()) -> tuple[int, list[str], str]:
+    """A streaming roc command interrupted (SIGINT, as Ctrl+C) once it has printed ``lines`` lines (with
+    ``topics``: that many JSON lines for each of them), or after 30 s: its exit code, stdout lines, stderr.
+    Waiting for output, not for a fixed time, keeps a slow discovery from failing the test."""
     process = subprocess.Popen([str(BIN / "roc"), *args], env=env, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True)
+
+    def enough(printed: list[str]) -> bool:
+        if not topics:
+            return len(printed) >= lines
+        seen = [json.loads(line)["topic"] for line in printed]
+        return all(seen.count(topic) >= lines for topic in topics)
     try:
-        time.sleep(seconds)
+        printed: list[str] = []
+        deadline = time.monotonic() + 30
+        while not enough(printed) and (line := read_line(process, deadline - time.monotonic())):
+            printed.append(line.rstrip("\n"))
         process.send_signal(signal.SIGINT)
-        out, err = process.communicate(timeout=10)
+        while line := read_line(process, 10):
+            printed.append(line.rstrip("\n"))
+        process.wait(timeout=10)
+        err = process.stderr.read()
     finally:
         stop_process(process)
-    return process.returncode, out, err
+    return process.returncode, printed, err
 
 
 @pytest.mark.distro
@@ -178,27 +193,27 @@ def test_hz_bw_and_delay_measure_live_topics(graph) -> None:
     from std_msgs.msg import String
 
     env, _ = graph
-    code, out, err = _run_for(3.5, "topic", "hz", "/chatter", "/stamped", "--format", "json", env=env)
+    code, out, err = _run_until("topic", "hz", "/chatter", "/stamped", "--format", "json", lines=3,
+                                topics=("/chatter", "/stamped"), env=env)
     assert code == 130, err
-    last = {line["topic"]: line for line in map(json.loads, out.splitlines())}
+    last = {line["topic"]: line for line in map(json.loads, out)}
     assert last["/chatter"]["rate"] == pytest.approx(20, rel=0.02)
     assert last["/stamped"]["rate"] == pytest.approx(50, rel=0.02)
     assert last["/chatter"]["lost"] == 0
-    code, out, _ = _run_for(2.5, "topic", "hz", "/chatter", env=env)
-    lines = out.splitlines()
-    assert lines[0].startswith("average rate: ") and float(lines[0].split(": ")[1]) == pytest.approx(20, rel=0.02)
-    assert lines[1].startswith("\tmin: ") and " window: " in lines[1]
+    code, out, _ = _run_until("topic", "hz", "/chatter", lines=2, env=env)
+    assert out[0].startswith("average rate: ") and float(out[0].split(": ")[1]) == pytest.approx(20, rel=0.02)
+    assert out[1].startswith("\tmin: ") and " window: " in out[1]
 
-    code, out, _ = _run_for(2.5, "topic", "bw", "/chatter", env=env)
+    code, out, _ = _run_until("topic", "bw", "/chatter", lines=3, env=env)
     size = -(-len(serialize_message(String(data="hello"))) // 4) * 4  # as received: padded to 4 bytes
-    assert out.splitlines()[0] == "Subscribed to [/chatter]"
-    assert out.splitlines()[2] == f"\tMessage size mean: {size} B min: {size} B max: {size} B"
-    code, out, _ = _run_for(2.5, "topic", "bw", "/chatter", "--format", "json", env=env)
-    bandwidth = json.loads(out.splitlines()[-1])
+    assert out[0] == "Subscribed to [/chatter]"
+    assert out[2] == f"\tMessage size mean: {size} B min: {size} B max: {size} B"
+    code, out, _ = _run_until("topic", "bw", "/chatter", "--format", "json", lines=2, env=env)
+    bandwidth = json.loads(out[-1])
     assert bandwidth["bytes_per_second"] == pytest.approx(size * 20, rel=0.1)
 
-    code, out, _ = _run_for(2.5, "topic", "delay", "/stamped", "--format", "json", env=env)
-    delay = json.loads(out.splitlines()[-1])
+    code, out, _ = _run_until("topic", "delay", "/stamped", "--format", "json", lines=2, env=env)
+    delay = json.loads(out[-1])
     assert 0 <= delay["min"] <= delay["delay"] <= delay["max"] < 0.5
 
 
