@@ -15,6 +15,11 @@ if TYPE_CHECKING:
     from typing import Any, TextIO
 
 
+def plural(count: int, word: str) -> str:
+    """``1 topic``, ``3 topics``."""
+    return f"{count} {word}{'' if count == 1 else 's'}"
+
+
 def print_lines(lines: Iterable[str], stream: TextIO | None = None) -> None:
     (stream or sys.stdout).write("".join(f"{line}\n" for line in lines))
 

@@ -21,6 +21,7 @@ from roc.engine.events import (
     TestFailures,
 )
 from roc.handlers.logs import task_log_folder
+from roc.render import plural
 
 
 def format_duration(seconds: float) -> str:
@@ -30,10 +31,6 @@ def format_duration(seconds: float) -> str:
         return f"{seconds:.1f}s"
     minutes, rest = divmod(int(round(seconds)), 60)
     return f"{minutes}min {rest}s"
-
-
-def _plural(n: int, word: str) -> str:
-    return f"{n} {word}{'' if n == 1 else 's'}"
 
 
 def _names(labels: Collection[str]) -> str:
@@ -52,8 +49,8 @@ def _count(labels: list[str], noun: str = "package") -> str:
         if ":" in label:
             kind = label.split(":", 1)[0]
             other_kinds[kind] = other_kinds.get(kind, 0) + 1
-    parts = [_plural(len(packages), noun)] if packages or not other_kinds else []
-    parts += [_plural(n, f"{kind} task") for kind, n in sorted(other_kinds.items())]
+    parts = [plural(len(packages), noun)] if packages or not other_kinds else []
+    parts += [plural(n, f"{kind} task") for kind, n in sorted(other_kinds.items())]
     return " and ".join(parts)
 
 

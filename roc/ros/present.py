@@ -11,10 +11,6 @@ def is_hidden(name: str) -> bool:
     return any(token.startswith("_") for token in name.split("/"))
 
 
-def plural(count: int, word: str) -> str:
-    return f"{count} {word}{'' if count == 1 else 's'}"
-
-
 def _duration(ns: int | None) -> str:
     return "Infinite" if ns is None else f"{ns} nanoseconds"
 

@@ -20,6 +20,7 @@ from pathlib import Path
 from lxml import etree
 
 from roc.messages import warn
+from roc.render import plural
 
 COUNTS = ("tests", "errors", "failures", "skipped")
 # colcon's attribute -> count mapping; None marks a required attribute.
@@ -61,8 +62,6 @@ class Result:
 
     def line(self) -> str:
         """colcon's line: ``<path>: 3 tests, 0 errors, 1 failure, 1 skipped``."""
-        def plural(count: int, word: str) -> str:
-            return f"{count} {word}{'' if count == 1 else 's'}"
         return (f"{self.path}: {plural(self.tests, 'test')}, {plural(self.errors, 'error')}, "
                 f"{plural(self.failures, 'failure')}, {self.skipped} skipped")
 

@@ -18,7 +18,7 @@ from textual.widgets import DataTable, Footer, Input, Static, TabbedContent, Tab
 from textual.worker import get_current_worker
 
 from roc.errors import RocError
-from roc.ros.present import plural
+from roc.render import plural
 from roc.tui.feed import measure_rates
 from roc.tui.model import Rates, counts, node_rows, topic_rows, typed_rows, visible
 from roc.tui.problems import Problem, Watch

@@ -283,7 +283,7 @@ def test_play_options_select_rename_cut_and_clock(tmp_path):
         output = play_when_recorder_listens(tmp_path / "source", recorder, ["/renamed", "/clock"], env, tmp_path,
                                             "--topics", "/a", "--remap", "a:=renamed", "--start-offset", "0.2",
                                             "--playback-duration", "0.5", "--clock", "100")
-        assert "Played 51 messages on 1 topics" in output
+        assert "Played 51 messages on 1 topic" in output
         assert "deprecated" not in output and "[rcl]" not in output, output
         interrupt(recorder)
     finally:
@@ -342,7 +342,7 @@ def test_arrow_keys_step_and_change_the_rate_and_a_sim_time_recording_takes_the_
         assert "Rate: 0.909" in wait_for_line(player, "Rate:")[-1]
         os.write(controller, b" ")
         output = "".join(wait_for_line(player, "Played", timeout=60))
-        assert "Played 40 messages on 1 topics" in output, output
+        assert "Played 40 messages on 1 topic" in output, output
         assert player.wait(timeout=60) == 0, player.stderr.read()
         interrupt(wall)
         interrupt(simulated)
@@ -390,11 +390,11 @@ def test_wait_for_subscribers_holds_playback_until_each_topic_is_heard(tmp_path)
                          "--disable-keyboard-controls", str(tmp_path / "source"), env=env, cwd=tmp_path)
     listener = None
     try:
-        wait_for_line(player, "Waiting for a subscriber on each of 1 topics")
+        wait_for_line(player, "Waiting for a subscriber on each of 1 topic")
         assert read_line(player, 2.0) is None  # nothing played, nobody listens
         listener = start_nodes([{"name": "listener", "subscribers": [
             {"topic": "a", "type": "std_msgs/msg/String", "depth": 100, "print": True}]}], env)[0]
-        assert "Played 20 messages on 1 topics" in "".join(wait_for_line(player, "Played", timeout=60))
+        assert "Played 20 messages on 1 topic" in "".join(wait_for_line(player, "Played", timeout=60))
         assert player.wait(timeout=30) == 0, player.stderr.read()
         assert [_heard_index(listener, 10.0) for _ in range(20)] == list(range(20))
     finally:
@@ -422,7 +422,7 @@ def test_a_type_only_the_bag_defines_is_built_once_and_played(tmp_path):
         (prefix,) = (tmp_path / "cache" / "bag-types").iterdir()
         recorder = roc_process("bag", "record", "/vec", "-o", "out", env=environment_with(prefix, env), cwd=tmp_path)
         wait_subscribed(recorder, ["/vec"])
-        assert "Played 10 messages on 1 topics" in "".join(wait_for_line(player, "Played", timeout=60))
+        assert "Played 10 messages on 1 topic" in "".join(wait_for_line(player, "Played", timeout=60))
         assert player.wait(timeout=30) == 0
         assert f"building bagonly_msgs from the bag's own definitions (not installed here; once, into {prefix})" in (
             player.stderr.read())

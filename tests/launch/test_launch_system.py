@@ -108,7 +108,7 @@ def test_a_later_process_waits_for_a_service(demo, tmp_path: Path) -> None:
     waited = float(re.search(r"load_map is available: met after ([\d.]+) s", output)[1])
     assert waited >= 2.0  # the server creates its service 2 s after it starts (its 'delay')
     assert "[INFO] [robot1/talker]: waiting for service /map_server/load_map is available" in output
-    assert output.count("process has finished cleanly") == 3
+    assert output.count("process has finished cleanly") == 3, output
     log = (tmp_path / "log" / "latest_launch" / "robot1_talker.log").read_text()
     assert "[INFO] [" in log and "[robot1.talker]: ready" in log
 

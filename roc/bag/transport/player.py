@@ -26,6 +26,7 @@ from roc.bag.reader import Bag
 from roc.bag.selection import Selection
 from roc.bag.transport.ros_qos import profile
 from roc.errors import RocError
+from roc.render import plural
 from roc.ros.graph import Graph
 from roc.ros.types import UnknownTypeError, message_class
 
@@ -253,7 +254,7 @@ class Player:
         wanted = self.options.wait_for_subscribers
         waiting = sorted(publishers)
         self._report(f"Waiting for {'a subscriber' if wanted == 1 else f'{wanted} subscribers'} on each of "
-                     f"{len(waiting)} topics")
+                     f"{plural(len(waiting), 'topic')}")
         with self._changed:
             while waiting and not self._stopping:
                 waiting = [name for name in waiting if publishers[name].get_subscription_count() < wanted]

@@ -9,7 +9,7 @@ from pathlib import Path
 from roc.bag.convert import convert, read_output_options
 from roc.bag.reader import STORAGES
 from roc.errors import UsageError
-from roc.render import print_lines
+from roc.render import plural, print_lines
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -30,7 +30,8 @@ def run(args: argparse.Namespace) -> int:
         inputs.append((given[0], given[1] if len(given) == 2 else None))
     outputs = read_output_options(Path(args.output_options))
     written = convert(inputs, outputs)
-    print_lines(f"wrote {output.uri}: {metadata.message_count} messages on {len(metadata.topics)} topics "
-                f"({metadata.storage_identifier}, {len(metadata.relative_file_paths)} file(s))"
+    print_lines(f"wrote {output.uri}: {plural(metadata.message_count, 'message')} on "
+                f"{plural(len(metadata.topics), 'topic')} ({metadata.storage_identifier}, "
+                f"{plural(len(metadata.relative_file_paths), 'file')})"
                 for output, metadata in zip(outputs, written))
     return 0

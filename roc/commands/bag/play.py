@@ -13,7 +13,7 @@ import sys
 from roc.bag.reader import STORAGES
 from roc.bag.selection import Selection
 from roc.errors import UsageError
-from roc.render import print_lines, print_text
+from roc.render import plural, print_lines, print_text
 
 
 def _positive(text: str) -> float:
@@ -101,7 +101,7 @@ def _selection(args: argparse.Namespace) -> Selection | None:
 
 def _summary(result) -> list[str]:
     total = sum(result.published.values())
-    lines = [f"Played {total} messages on {len(result.published)} topics"]
+    lines = [f"Played {plural(total, 'message')} on {plural(len(result.published), 'topic')}"]
     if result.lateness_ns:
         late = sorted(abs(x) for x in result.lateness_ns)
         p99 = late[min(len(late) - 1, int(len(late) * 0.99))]

@@ -15,7 +15,7 @@ from roc.bag.reader import STORAGES
 from roc.bag.selection import Selection
 from roc.bag.writer import DEFAULT_STORAGE, WriteOptions, check_options
 from roc.errors import EXIT_FAILURE, UsageError
-from roc.render import print_lines, print_text, table_lines
+from roc.render import plural, print_lines, print_text, table_lines
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -120,8 +120,8 @@ def repeat_options(given: list[str] | None, every: int) -> tuple[dict[str, int],
 
 def _summary(result, uri: str) -> list[str]:
     metadata = result.metadata
-    lines = [f"Recorded {metadata.message_count} messages on {len(metadata.topics)} topics into {uri} "
-             f"({len(metadata.relative_file_paths)} file(s))"]
+    lines = [f"Recorded {plural(metadata.message_count, 'message')} on {plural(len(metadata.topics), 'topic')} "
+             f"into {uri} ({plural(len(metadata.relative_file_paths), 'file')})"]
     if result.stats:
         lines += table_lines([[name, s.received, s.written, s.lost] for name, s in result.stats.items()],
                              header=["topic", "received", "written", "lost"])

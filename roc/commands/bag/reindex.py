@@ -7,7 +7,7 @@ import argparse
 
 from roc.bag.reindex import reindex
 from roc.commands.bag.common import add_bag_argument, print_notes
-from roc.render import print_text
+from roc.render import plural, print_text
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -19,6 +19,6 @@ def run(args: argparse.Namespace) -> int:
 
     metadata, repaired = reindex(Path(args.bag_path), args.storage)
     print_notes(repaired)
-    print_text(f"wrote {Path(args.bag_path) / 'metadata.yaml'}: {len(metadata.relative_file_paths)} file(s), "
-               f"{metadata.message_count} messages on {len(metadata.topics)} topics\n")
+    print_text(f"wrote {Path(args.bag_path) / 'metadata.yaml'}: {plural(len(metadata.relative_file_paths), 'file')}, "
+               f"{plural(metadata.message_count, 'message')} on {plural(len(metadata.topics), 'topic')}\n")
     return 0

@@ -5,9 +5,8 @@ from __future__ import annotations
 import argparse
 
 from roc.cli.options import add_format_argument
-from roc.render import render
+from roc.render import plural, render
 from roc.ros.client import stop_all_daemons, stop_daemon
-from roc.ros.present import plural
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from roc.commands.graph_query import add_list_arguments, render_listing, run_list, snapshot, visible
-from roc.ros.present import plural
+from roc.render import plural
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
