@@ -16,7 +16,7 @@ from roc.engine.events import Event, ProbeResult
 from roc.engine.process import TaskCancelled, TaskContext, TaskError
 from roc.engine.ready import Task
 from roc.errors import RocError
-from roc.render import to_yaml_line
+from roc.render import plural, to_yaml_line
 from roc.ros.present import is_hidden, qos_problems
 from roc.ros.rates import Window, samples
 
@@ -145,7 +145,7 @@ def _topic(expectation: Expectation, session, timeout: float, window: float) -> 
             found.append(f"{rate:.2f} Hz")
     if failures:
         raise Failed("; ".join(failures), measured)
-    found.append(f"{measured['publishers']} publishers, {measured['subscribers']} subscribers")
+    found.append(f"{plural(measured['publishers'], 'publisher')}, {plural(measured['subscribers'], 'subscriber')}")
     return ", ".join(found), measured
 
 

@@ -141,6 +141,17 @@ def test_live_examples_name_their_graph_files_and_ctrl_c(tmp_path: Path) -> None
     assert unchecked_output_blocks(page) == [20]  # the last block
 
 
+def test_a_recording_waits_as_its_comment_says_and_indented_transcripts_are_unchecked(tmp_path: Path) -> None:
+    page = tmp_path / "page.md"
+    page.write_text("<!-- example: workspaces/example, graph demo, ctrl-c after 4.5 s -->\n```console\n"
+                    "$ roc bag record -a\nListening for topics...\n^C\n```\n\nText:\n\n    $ roc pkg list\n"
+                    "    demo_py\n\nA command alone:\n\n    roc pkg list\n\n<!-- not run: quoted -->\n\n"
+                    "    $ roc a\n    b\n")
+    (live,) = sequences(page)
+    assert live.commands[0].interrupt_after == 4.5
+    assert unchecked_output_blocks(page) == [10]  # the transcript; not the command alone, not the quoted one
+
+
 def _all_sequences() -> list:
     params = []
     for page in pages():

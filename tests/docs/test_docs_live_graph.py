@@ -76,6 +76,7 @@ def _run(command: Command, env: dict[str, str], cwd: Path) -> tuple[list[str], l
     """The command's output; with a ``^C`` in what the page shows, the output until the lines before it
     were printed, then SIGINT, and the output after it."""
     before, after = split_at_interrupt(command.expected)
+    started = time.monotonic()
     process = subprocess.Popen(["bash", "-c", command.command], cwd=cwd, env=env, stdin=subprocess.DEVNULL,
                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True)
     lines: queue.SimpleQueue[str | None] = queue.SimpleQueue()
@@ -106,6 +107,7 @@ def _run(command: Command, env: dict[str, str], cwd: Path) -> tuple[list[str], l
         if after is None:
             return read_until(lambda _seen: False, COMMAND_TIMEOUT), None
         shown = read_until(lambda seen: matches(before, seen), COMMAND_TIMEOUT)
+        time.sleep(max(0.0, started + command.interrupt_after - time.monotonic()))
         os.killpg(process.pid, signal.SIGINT)  # the reader's Ctrl+C, to the command's process group
         return shown, read_until(lambda _seen: False, COMMAND_TIMEOUT)
     finally:

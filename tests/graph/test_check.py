@@ -87,7 +87,7 @@ def test_a_system_that_meets_every_expectation(graph, tmp_path: Path) -> None:
     result = roc("-C", str(tmp_path), "graph", "check", "--junit-xml", str(report), env=graph)
     assert result.returncode == 0, result.stdout + result.stderr
     assert "Summary: 7 probes finished" in result.stdout
-    assert "Finished <<< topic /chatter [" in result.stdout and " Hz, 1 publishers, 1 subscribers" in result.stdout
+    assert "Finished <<< topic /chatter [" in result.stdout and " Hz, 1 publisher, 1 subscriber" in result.stdout
     suite = next(iter(JUnitXml.fromfile(str(report))))
     assert (suite.tests, suite.failures, suite.errors) == (7, 0, 0)
     assert sorted(case.name for case in suite) == ["/chatter", "/fibonacci", "/listener", "/motor", "/motor max_speed",

@@ -27,8 +27,10 @@ motor controller, a fibonacci server, ...); the block's commands run in a copy o
 that graph runs, in a ROS domain of the test's own, with the example workspace built and sourced. A
 command that runs until Ctrl+C shows `^C` on a line of its own where the reader pressed it: the test
 presses Ctrl+C (SIGINT) once the output before it has been printed, and the lines after `^C` are the
-last the command printed (what it printed while the signal was on its way does not count). A file an example needs is a block right after `<!-- example file:
-NAME -->` (any language), written as NAME into the directory of every example of that page before
+last the command printed (what it printed while the signal was on its way does not count). A command
+that prints nothing while it works, such as a recording, is interrupted as late as its comment says:
+`<!-- example: DIR, graph NAME, ctrl-c after 3 s -->`. A file an example needs is a block right after
+`<!-- example file: NAME -->` (any language), written as NAME into the directory of every example of that page before
 they run.
 
 A console block that shows output but cannot run (two machines, a client elsewhere) says why:
@@ -48,7 +50,8 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[2]
 BIN = Path(sys.executable).parent
 MARKER = re.compile(r"^<!--\s*example:\s*(?P<directory>[^,\s]+)\s*(?P<slow>,\s*slow\s*)?"
-                    r"(?:,\s*graph\s+(?P<graph>[\w-]+)\s*)?-->\s*$")
+                    r"(?:,\s*graph\s+(?P<graph>[\w-]+)\s*)?"
+                    r"(?:,\s*ctrl-c after\s+(?P<after>\d+(?:\.\d+)?)\s*s\s*)?-->\s*$")
 FILE_MARKER = re.compile(r"^<!--\s*example file:\s*(?P<name>[^\s]+)\s*-->\s*$")
 NOT_RUN = re.compile(r"^<!--\s*not run:\s*\S.*-->\s*$")
 ELLIPSIS = "..."
@@ -60,6 +63,7 @@ class Command:
     line: int  # 1-based line of the `$ ` line in its page
     command: str
     expected: list[str] = field(default_factory=list)
+    interrupt_after: float = 0.0  # the reader's Ctrl+C comes no sooner than this many seconds after the start
 
 
 @dataclass
@@ -121,7 +125,7 @@ def sequences(path: Path) -> list[Sequence]:
         started = False  # a command of this block was seen
         for number, text in enumerate(block, index + 2):
             if text.startswith("$ "):
-                sequence.commands.append(Command(number, text[2:]))
+                sequence.commands.append(Command(number, text[2:], interrupt_after=float(marker["after"] or 0)))
                 started = True
             elif not started:
                 raise ValueError(f"{page}:{number}: output before the first '$ ' command of the block")
@@ -135,17 +139,33 @@ def sequences(path: Path) -> list[Sequence]:
 
 def unchecked_output_blocks(path: Path) -> list[int]:
     """The lines of the console blocks of a page that show output (a line not starting with ``$ ``) but are
-    neither run (an example comment) nor say why not (a not-run comment)."""
+    neither run (an example comment) nor say why not (a not-run comment); a transcript in an indented code
+    block (a ``$ `` line and output) counts as an unchecked block too: make it a console block."""
     lines = path.read_text().splitlines()
     unchecked = []
-    for index, line in enumerate(lines):
-        if line.rstrip() != "```console":
+    index = 0
+    while index < len(lines):
+        line = lines[index]
+        if line.startswith("```"):  # fenced: skip to its end, checking console blocks
+            block, end = _fenced_block(lines, index, str(path))
+            before = lines[index - 1] if index else ""
+            if line.rstrip() == "```console" and any(text.strip() and not text.startswith("$ ") for text in block) \
+                    and not (MARKER.match(before) or NOT_RUN.match(before)):
+                unchecked.append(index + 1)
+            index = end
             continue
-        before = lines[index - 1] if index else ""
-        block, _ = _fenced_block(lines, index, str(path))
-        if any(text.strip() and not text.startswith("$ ") for text in block) and not (
-                MARKER.match(before) or NOT_RUN.match(before)):
-            unchecked.append(index + 1)
+        if line.startswith("    ") and (index == 0 or not lines[index - 1].strip()):  # an indented block
+            end = index
+            while end < len(lines) and (lines[end].startswith("    ") or not lines[end].strip()):
+                end += 1
+            block = [text[4:] for text in lines[index:end] if text.strip()]
+            said = NOT_RUN.match(block[0]) or (index >= 2 and NOT_RUN.match(lines[index - 2]))  # a quoted example
+            if any(text.startswith("$ ") for text in block) and any(not text.startswith("$ ") for text in block) \
+                    and not said:
+                unchecked.append(index + 1)
+            index = end
+            continue
+        index += 1
     return unchecked
 
 
