@@ -14,18 +14,24 @@ comes after its writer, under load 0.1 s and more later): it is heard once one o
 node name, or, for roc's own participants (which have no endpoints), once a node named for its process
 is known (``unheard_participants``).
 
+A fresh participant's first announcement goes out before Fast DDS listens, so it would hear some of
+them only at their next periodic announcement: it asks them to announce themselves again
+(``ask_local_participants_to_announce``, roc.ros.spdp).
+
 Participants on other hosts (a discovery range beyond this host) cannot be counted: the caller waits
-for the graph to go quiet for them. This module reads /proc and rclpy endpoint infos; it never
-imports rclpy itself (``roc tui`` finds each node's process with it too).
+for the graph to go quiet for them. This module reads /proc and rclpy endpoint infos and sends UDP
+datagrams; it never imports rclpy itself (``roc tui`` finds each node's process with it too).
 """
 
 from __future__ import annotations
 
 import os
+import socket
 from pathlib import Path
 from typing import Any
 
 from roc.ros.protocol import OWN_NODE_PREFIX, is_own_node
+from roc.ros.spdp import stand_in_announcement
 
 PORT_BASE = 7400
 DOMAIN_GAIN = 250
@@ -64,21 +70,60 @@ def own_socket_inodes() -> set[str]:
     return inodes
 
 
+def metatraffic_sockets(domain_id: int, tables: tuple[Path, ...] = UDP_TABLES) -> list[tuple[str | None, int, bool]]:
+    """The metatraffic unicast sockets bound on this host (this network namespace) in ``domain_id``:
+    (IPv4 address, None for IPv6; port; whether this process owns it). Raises OSError when the UDP
+    tables cannot be read (not Linux)."""
+    own = own_socket_inodes()
+    sockets = []
+    for table in tables:
+        for line in table.read_text().splitlines()[1:]:
+            fields = line.split()
+            address, port_hex = fields[1].rsplit(":", 1)
+            port = int(port_hex, 16)
+            if is_metatraffic_port(port, domain_id):
+                ipv4 = ".".join(str(b) for b in reversed(bytes.fromhex(address))) if len(address) == 8 else None
+                sockets.append((ipv4, port, fields[9] in own))
+    return sockets
+
+
 def local_participant_count(domain_id: int, tables: tuple[Path, ...] = UDP_TABLES) -> int | None:
     """How many participants of other processes on this host (this network namespace) are in
     ``domain_id``; None when the UDP tables cannot be read (not Linux)."""
-    own = own_socket_inodes()
-    bound: set[int] = set()
     try:
-        for table in tables:
-            for line in table.read_text().splitlines()[1:]:
-                fields = line.split()
-                port = int(fields[1].rsplit(":", 1)[1], 16)
-                if is_metatraffic_port(port, domain_id) and fields[9] not in own:
-                    bound.add(port)
+        return len({port for _, port, own in metatraffic_sockets(domain_id, tables) if not own})
     except (OSError, IndexError, ValueError):
         return None
-    return len(bound)
+
+
+def ask_local_participants_to_announce(domain_id: int, tables: tuple[Path, ...] = UDP_TABLES) -> int:
+    """Send every participant of another process on this host in ``domain_id`` the announcement of a
+    stand-in participant whose locators are this process's participants' discovery ports, so that each
+    announces itself to them at once (why: roc.ros.spdp). Returns how many were asked (0 where the UDP
+    tables cannot be read)."""
+    try:
+        sockets = metatraffic_sockets(domain_id, tables)
+    except (OSError, IndexError, ValueError):
+        return 0
+    ours = sorted({(_reachable(address), port) for address, port, own in sockets if own and address})
+    peers = sorted({(_reachable(address), port) for address, port, own in sockets if not own and address})
+    if not ours or not peers:
+        return 0
+    message = stand_in_announcement(domain_id, ours)
+    asked = 0
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
+        for peer in peers:
+            try:
+                sender.sendto(message, peer)
+                asked += 1
+            except OSError:  # gone meanwhile, or a full buffer: that one is heard at its next announcement
+                continue
+    return asked
+
+
+def _reachable(address: str) -> str:
+    """The address to send to for a socket bound to ``address`` (any address: this host's loopback)."""
+    return "127.0.0.1" if address == "0.0.0.0" else address
 
 
 def discovered_local_peers(writers: list[Any], pid: int) -> int | None:

@@ -30,6 +30,7 @@ from roc.errors import RocError
 from roc.ros.discovery import (
     DISCOVERY_TOPIC,
     UNKNOWN_NODE,
+    ask_local_participants_to_announce,
     discovered_local_peers,
     local_participant_count,
     unheard_participants,
@@ -168,6 +169,7 @@ class Graph:
         for publisher in list(self.node.publishers):
             if publisher.topic_name == "/parameter_events":
                 self.node.destroy_publisher(publisher)
+        ask_local_participants_to_announce(self.context.get_domain_id())
         self.events = events
         self.executor = EventsExecutor(context=self.context) if events else SingleThreadedExecutor(context=self.context)
         self._stopping = threading.Event()

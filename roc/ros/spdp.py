@@ -1,0 +1,72 @@
+"""The one RTPS message roc writes itself: a participant announcement (SPDP DATA(p), RTPS 2.3 8.5.3 and
+9.6.2) of a short-lived stand-in participant that names roc's own participant's discovery port.
+
+Why: a Fast DDS participant (2.14 and 3.x alike) sends its first announcement before it listens
+(RTPSParticipantImpl::enable), so the announcements other participants send back at once to the newcomer
+are lost, and it hears them only at their next periodic announcement, up to 3 s later. Every participant
+answers a participant it has not seen before by announcing itself to that participant's metatraffic
+locators (Fast DDS's PDPStatelessWriter marks it an interested reader); the stand-in's locators are the
+fresh participant's own port, so the answers reach a participant that now listens. The stand-in has only
+the announcement endpoints (no endpoint discovery, no ROS enclave: rmw ignores it) and a lease of one
+second, after which every participant forgets it.
+"""
+
+from __future__ import annotations
+
+import ipaddress
+import os
+import struct
+
+VENDOR_UNKNOWN = b"\x00\x00"  # roc is no DDS vendor (RTPS 9.3.1.5)
+PROTOCOL_VERSION = b"\x02\x03"
+SUBMESSAGE_DATA = 0x15
+FLAGS_LITTLE_ENDIAN_WITH_DATA = 0x05  # E and D flags
+SPDP_READER = bytes.fromhex("000100c7")
+SPDP_WRITER = bytes.fromhex("000100c2")
+PARTICIPANT_ENTITY = bytes.fromhex("000001c1")
+PL_CDR_LE = b"\x00\x03\x00\x00"
+LOCATOR_KIND_UDPV4 = 1
+# parameter ids (RTPS 9.6.2.2.2, table 9.12)
+PID_SENTINEL = 0x0001
+PID_PARTICIPANT_LEASE_DURATION = 0x0002
+PID_DOMAIN_ID = 0x000F
+PID_PROTOCOL_VERSION = 0x0015
+PID_VENDORID = 0x0016
+PID_DEFAULT_UNICAST_LOCATOR = 0x0031
+PID_METATRAFFIC_UNICAST_LOCATOR = 0x0032
+PID_PARTICIPANT_GUID = 0x0050
+PID_BUILTIN_ENDPOINT_SET = 0x0058
+PARTICIPANT_ANNOUNCER_AND_DETECTOR = 0x3  # the only builtin endpoints the stand-in has
+LEASE_SECONDS = 1
+
+
+def _parameter(pid: int, value: bytes) -> bytes:
+    value += b"\0" * (-len(value) % 4)
+    return struct.pack("<HH", pid, len(value)) + value
+
+
+def _udp_locator(address: str, port: int) -> bytes:
+    return struct.pack("<iI", LOCATOR_KIND_UDPV4, port) + bytes(12) + ipaddress.IPv4Address(address).packed
+
+
+def stand_in_announcement(domain_id: int, locators: list[tuple[str, int]], prefix: bytes | None = None) -> bytes:
+    """One RTPS message: the announcement of a stand-in participant (GUID prefix ``prefix``, random when
+    None) in ``domain_id`` whose metatraffic and default unicast locators are ``locators`` (IPv4 address,
+    UDP port)."""
+    prefix = os.urandom(12) if prefix is None else prefix
+    parameters = [
+        _parameter(PID_PROTOCOL_VERSION, PROTOCOL_VERSION),
+        _parameter(PID_VENDORID, VENDOR_UNKNOWN),
+        _parameter(PID_DOMAIN_ID, struct.pack("<I", domain_id)),
+        _parameter(PID_PARTICIPANT_GUID, prefix + PARTICIPANT_ENTITY),
+        *(_parameter(pid, _udp_locator(address, port)) for address, port in locators
+          for pid in (PID_METATRAFFIC_UNICAST_LOCATOR, PID_DEFAULT_UNICAST_LOCATOR)),
+        _parameter(PID_PARTICIPANT_LEASE_DURATION, struct.pack("<iI", LEASE_SECONDS, 0)),
+        _parameter(PID_BUILTIN_ENDPOINT_SET, struct.pack("<I", PARTICIPANT_ANNOUNCER_AND_DETECTOR)),
+        struct.pack("<HH", PID_SENTINEL, 0),
+    ]
+    sequence_number = struct.pack("<iI", 0, 1)
+    # extraFlags, octetsToInlineQos (from after this field to the writer sequence number's end: 16)
+    body = struct.pack("<HH", 0, 16) + SPDP_READER + SPDP_WRITER + sequence_number + PL_CDR_LE + b"".join(parameters)
+    submessage = bytes([SUBMESSAGE_DATA, FLAGS_LITTLE_ENDIAN_WITH_DATA]) + struct.pack("<H", len(body)) + body
+    return b"RTPS" + PROTOCOL_VERSION + VENDOR_UNKNOWN + prefix + submessage
