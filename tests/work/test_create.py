@@ -4,7 +4,9 @@ sourced and run, on a ROS graph of their own."""
 from __future__ import annotations
 
 import ast
+import contextlib
 import datetime
+import io
 import os
 import re
 import subprocess
@@ -30,6 +32,8 @@ from helpers.build import (
     without_own_underlay,
 )
 
+from roc.cli.main import main
+
 MAINTAINER = ("--maintainer-name", "Ada Lovelace", "--maintainer-email", "ada@example.com")
 OPTIONS = ("--build-type", "--dependencies", "--node-name", "--library-name", "--license", "--maintainer-name",
            "--maintainer-email", "--description", "--package-format", "--destination-directory", "--interfaces",
@@ -53,7 +57,26 @@ def _env(**extra: str) -> dict[str, str]:
 
 
 def create(cwd: Path, *args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
-    return roc("work", "create", *args, cwd=cwd, env=env or _env())
+    """``roc work create ARGS`` in ``cwd`` with ``env`` as its whole environment, run in this process (this
+    file creates some 60 packages: as processes, 10 s of the quick loop); its exit code and output as a
+    finished process's. test_create_runs_as_the_roc_command runs it as a process."""
+    argv = ["work", "create", *args]
+    saved_environment, saved_directory = dict(os.environ), os.getcwd()
+    stdout, stderr = io.StringIO(), io.StringIO()
+    try:
+        os.environ.clear()
+        os.environ.update(env or _env())
+        os.chdir(cwd)
+        with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+            try:
+                code = main(argv)
+            except SystemExit as exit_request:
+                code = exit_request.code if isinstance(exit_request.code, int) else 1
+    finally:
+        os.chdir(saved_directory)
+        os.environ.clear()
+        os.environ.update(saved_environment)
+    return subprocess.CompletedProcess(argv, code, stdout.getvalue(), stderr.getvalue())
 
 
 def created(cwd: Path, *args: str) -> subprocess.CompletedProcess:
@@ -403,6 +426,24 @@ def test_an_interrupted_write_leaves_nothing(tmp_path, monkeypatch, failure):
     assert written and list(tmp_path.iterdir()) == []
 
 
+def test_create_runs_as_the_roc_command(tmp_path):
+    """The roc command prints, writes and exits as this file's in-process runs do, errors included."""
+    def files(root: Path) -> dict[str, bytes]:
+        return {str(p.relative_to(root)): p.read_bytes() for p in root.rglob("*") if p.is_file()}
+
+    for args, code in [(("pkg", "--build-type", "ament_python", "--node-name", "talker", "--license", "MIT"), 0),
+                       (("My-Pkg",), 2)]:
+        process_dir, in_process_dir = tmp_path / f"process{code}", tmp_path / f"in_process{code}"
+        process_dir.mkdir()
+        in_process_dir.mkdir()
+        as_process = roc("work", "create", *args, *MAINTAINER, cwd=process_dir, env=_env())
+        in_process = create(in_process_dir, *args, *MAINTAINER)
+        assert (as_process.returncode, as_process.stdout, as_process.stderr) == \
+            (in_process.returncode, in_process.stdout, in_process.stderr)
+        assert as_process.returncode == code and as_process.stdout.startswith("created package pkg" if code == 0 else "")
+        assert files(process_dir) == files(in_process_dir)
+
+
 def test_destination_defaults_to_the_workspace_src(tmp_path):
     ws = workspace(tmp_path / "ws")
     deep = ws / "src" / "some_pkg" / "sub"
@@ -475,24 +516,23 @@ def test_help_documents_every_option(tmp_path):
 
 def test_create_refuses_a_missing_parent_unless_asked(tmp_path: Path) -> None:
     missing = tmp_path / "nonexistent" / "dir"
-    refused = roc("work", "create", "pkg_a", "--destination-directory", str(missing), cwd=tmp_path)
+    refused = create(tmp_path, "pkg_a", "--destination-directory", str(missing))
     assert refused.returncode == 2
     assert refused.stderr.startswith(f"roc: error: --destination-directory {missing}: {missing.parent} does not "
                                      "exist; create it, or add --parents")
     assert not (tmp_path / "nonexistent").exists()
-    made = roc("work", "create", "pkg_a", "--destination-directory", str(missing), "--parents", cwd=tmp_path)
+    made = create(tmp_path, "pkg_a", "--destination-directory", str(missing), "--parents")
     assert made.returncode == 0, made.stderr
     assert (missing / "pkg_a" / "package.xml").is_file()
     # the destination itself may be new, as with mkdir
-    assert roc("work", "create", "pkg_b", "--destination-directory", "new", cwd=tmp_path).returncode == 0
+    assert create(tmp_path, "pkg_b", "--destination-directory", "new").returncode == 0
 
 
 def test_create_refuses_a_name_the_workspace_already_has(tmp_path: Path) -> None:
     workspace = copy_fixture("selection", tmp_path / "ws")
     before = sorted(p.relative_to(workspace) for p in workspace.rglob("*"))
     for destination in ("src", "src/new_group"):
-        result = roc("work", "create", "core", "--build-type", "ament_python", "--destination-directory",
-                     destination, cwd=workspace)
+        result = create(workspace, "core", "--build-type", "ament_python", "--destination-directory", destination)
         assert result.returncode == 2
         assert result.stderr.startswith(f"roc: error: the workspace {workspace} already has a package named "
                                         f"'core' (in {workspace / 'src' / 'core'}); choose another name")
