@@ -1,3 +1,4 @@
 from roc.cli.main import main
+from roc.cli.process_exit import finish
 
-raise SystemExit(main())
+finish(main())

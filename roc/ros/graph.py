@@ -63,6 +63,15 @@ SERVICE_TIMEOUT = 5.0
 SPIN_SLICE = 0.1  # seconds an executor waits before it looks whether the graph is closing
 
 
+OPEN_GRAPHS: set[int] = set()  # id() of every Graph whose rclpy context is initialised and not closed yet
+
+
+def every_graph_closed() -> bool:
+    """No participant of this process's Graphs (the only rclpy contexts roc makes) is left: its process may
+    end without the middleware's teardown (roc.cli.process_exit)."""
+    return not OPEN_GRAPHS
+
+
 class NotFound(RocError):
     """An unknown topic, node, service, action or parameter (the message is ros2's wording)."""
 
@@ -161,6 +170,7 @@ class Graph:
         use_profile(profile)
         self.context = Context()
         rclpy.init(args=[], context=self.context, signal_handler_options=SignalHandlerOptions.NO, domain_id=domain_id)
+        OPEN_GRAPHS.add(id(self))
         # roc's own node shows as little as it can, to other tools too: no parameter, type description
         # or /rosout endpoints, and no /parameter_events publisher (its parameters never change)
         self.node = Node(node_name or own_node_name(os.getpid()), context=self.context, start_parameter_services=False,
@@ -197,6 +207,7 @@ class Graph:
         self.executor.shutdown(timeout_sec=1)
         rclpy.try_shutdown(context=self.context)
         self.node.destroy_node()
+        OPEN_GRAPHS.discard(id(self))  # rmw deleted the participant at the shutdown
 
     # -- discovery ------------------------------------------------------------------------------------
     def signature(self) -> tuple:

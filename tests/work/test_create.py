@@ -4,9 +4,7 @@ sourced and run, on a ROS graph of their own."""
 from __future__ import annotations
 
 import ast
-import contextlib
 import datetime
-import io
 import os
 import re
 import subprocess
@@ -31,8 +29,7 @@ from helpers.build import (
     stop_process,
     without_own_underlay,
 )
-
-from roc.cli.main import main
+from helpers.fixture_workspaces import Result, run_roc_inprocess
 
 MAINTAINER = ("--maintainer-name", "Ada Lovelace", "--maintainer-email", "ada@example.com")
 OPTIONS = ("--build-type", "--dependencies", "--node-name", "--library-name", "--license", "--maintainer-name",
@@ -56,30 +53,14 @@ def _env(**extra: str) -> dict[str, str]:
     return ros_env(**{"GIT_CONFIG_NOSYSTEM": "1", "GIT_CONFIG_GLOBAL": os.devnull, **extra})
 
 
-def create(cwd: Path, *args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
+def create(cwd: Path, *args: str, env: dict[str, str] | None = None) -> Result:
     """``roc work create ARGS`` in ``cwd`` with ``env`` as its whole environment, run in this process (this
-    file creates some 60 packages: as processes, 10 s of the quick loop); its exit code and output as a
-    finished process's. test_create_runs_as_the_roc_command runs it as a process."""
-    argv = ["work", "create", *args]
-    saved_environment, saved_directory = dict(os.environ), os.getcwd()
-    stdout, stderr = io.StringIO(), io.StringIO()
-    try:
-        os.environ.clear()
-        os.environ.update(env or _env())
-        os.chdir(cwd)
-        with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
-            try:
-                code = main(argv)
-            except SystemExit as exit_request:
-                code = exit_request.code if isinstance(exit_request.code, int) else 1
-    finally:
-        os.chdir(saved_directory)
-        os.environ.clear()
-        os.environ.update(saved_environment)
-    return subprocess.CompletedProcess(argv, code, stdout.getvalue(), stderr.getvalue())
+    file creates some 60 packages: as processes, 10 s of the quick loop). test_create_runs_as_the_roc_command
+    runs it as a process."""
+    return run_roc_inprocess(["work", "create", *args], cwd, env or _env())
 
 
-def created(cwd: Path, *args: str) -> subprocess.CompletedProcess:
+def created(cwd: Path, *args: str) -> Result:
     result = create(cwd, *args, *MAINTAINER)
     assert result.returncode == 0, result.stderr
     return result
