@@ -135,6 +135,10 @@ def cold(env: dict[str, str], runs: int, extra: tuple[str, ...]) -> list[tuple]:
                 elapsed, out, _ = timed(name, command + extra, env)
                 times[name].append(elapsed)
                 complete[name] += out == expected
+                if name == "roc" and out != expected:  # say what roc missed (or added), to find out why
+                    missed = sorted(set(expected.splitlines()) - set(out.splitlines()))
+                    added = sorted(set(out.splitlines()) - set(expected.splitlines()))
+                    print(f"roc {' '.join(command + extra)}: missed {missed}, added {added}", file=sys.stderr)
         subprocess.run([tool("roc"), "daemon", "start"], env=env, capture_output=True, timeout=60)
         rows.append((" ".join(command), statistics.median(times["roc"]), statistics.median(times["ros2"]),
                      complete["roc"], complete["ros2"]))

@@ -209,6 +209,7 @@ def test_metadata_yaml_is_version_9(tmp_path):
     assert info["duration"]["nanoseconds"] == (3 * len(TEST_MSGS) - 1) * 1_000_000
 
 
+@pytest.mark.slow  # over a second (the quick loop stays under 45 s)
 def test_split_by_size_and_duration(tmp_path):
     from rosbags.rosbag2 import Reader
 
@@ -433,6 +434,7 @@ def test_list_names_formats():
 
 # ---- roc interface show --bag: a type only a bag knows -------------------------------------------
 
+@pytest.mark.slow  # over a second (the quick loop stays under 45 s)
 def test_interface_show_from_a_bag_matches_the_installed_definition(tmp_path: Path) -> None:
     """A bag roc wrote holds the full definitions: shown from it, a type reads as from the ament index."""
     write_test_msgs(tmp_path / "bag", rounds=1)

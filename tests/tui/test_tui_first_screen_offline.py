@@ -132,6 +132,7 @@ def test_rates_are_measured_again_only_for_the_topics_in_view() -> None:
     assert rates.texts("/b")[0] == "1.7 Hz"
 
 
+@pytest.mark.slow  # over a second (the quick loop stays under 45 s)
 def test_the_lists_under_another_screen_are_drawn_when_it_is_back() -> None:
     """The first screen's lists are not drawn while another screen covers them (a plot's CPU went to
     them), and are drawn from the latest snapshot when it is back."""
