@@ -56,9 +56,12 @@ def heard_static(bag_file: Path, env: dict[str, str]) -> set[tuple[str, str]]:
     listener = node("listen", env)
     heard: set[tuple[str, str]] = set()
     try:
-        # (the file's tf_static, played once the listener is matched: a file lasts a second)
+        # the file's tf_static, played once the listener is matched, and the player ends only once the
+        # listener has it: the writer may see the match before the listener does, and then the listener
+        # can take the message only from a writer that still exists (rosbag2's --wait-for-all-acked)
         player = subprocess.run([str(BIN / "roc"), "bag", "play", str(bag_file), "--topics", "/tf_static",
-                                 "--wait-for-subscribers", "--disable-keyboard-controls"],
+                                 "--wait-for-subscribers", "--wait-for-all-acked", "10000",
+                                 "--disable-keyboard-controls"],
                                 env=env, capture_output=True, text=True, timeout=60)
         assert player.returncode == 0, player.stderr
         while heard != STATIC and (line := read_line(listener, 10)):
