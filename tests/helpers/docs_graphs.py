@@ -28,8 +28,10 @@ READING_NODES = ("reading_publisher", "reading_listener")
 
 
 def _motor_controller() -> dict:
+    """The Fibonacci server takes 0.1 s a step, as a real one would: with none, its last feedback and its
+    result come at once, and which a client handles first is chance (the page shows both feedbacks)."""
     return {"name": "motor_controller", "services": [{"name": "~/enable", "type": "std_srvs/srv/SetBool"}],
-            "parameters": {"max_speed": 1.5}, "actions": [{"name": "/fibonacci"}]}
+            "parameters": {"max_speed": 1.5}, "actions": [{"name": "/fibonacci", "step_seconds": 0.1}]}
 
 
 def _readings(workspace: Path, env: dict[str, str], _root: Path) -> list[subprocess.Popen]:
