@@ -49,11 +49,11 @@ def _udp_locator(address: str, port: int) -> bytes:
     return struct.pack("<iI", LOCATOR_KIND_UDPV4, port) + bytes(12) + ipaddress.IPv4Address(address).packed
 
 
-def stand_in_announcement(domain_id: int, locators: list[tuple[str, int]], prefix: bytes | None = None) -> bytes:
-    """One RTPS message: the announcement of a stand-in participant (GUID prefix ``prefix``, random when
-    None) in ``domain_id`` whose metatraffic and default unicast locators are ``locators`` (IPv4 address,
-    UDP port)."""
-    prefix = os.urandom(12) if prefix is None else prefix
+def stand_in_announcement(domain_id: int, locators: list[tuple[str, int]]) -> bytes:
+    """One RTPS message: the announcement of a stand-in participant (a random GUID prefix: new to every
+    participant each time) in ``domain_id`` whose metatraffic and default unicast locators are
+    ``locators`` (IPv4 address, UDP port)."""
+    prefix = os.urandom(12)
     parameters = [
         _parameter(PID_PROTOCOL_VERSION, PROTOCOL_VERSION),
         _parameter(PID_VENDORID, VENDOR_UNKNOWN),
