@@ -36,7 +36,7 @@ def run_checks(checks: CheckFile, options: CheckOptions, stream: TextIO, stopped
     from roc.engine.executor import execute
     from roc.ros.client import Session
 
-    session = Session(use_daemon=options.use_daemon, spin_time=options.spin_time)
+    session = Session(use_daemon=options.use_daemon, spin_time=options.spin_time, long_lived=True)
     try:
         tasks = [probe_task(e, session, checks.timeout, checks.rate_window, wait=checks.timeout, stopped=stopped)
                  for e in checks.expectations]

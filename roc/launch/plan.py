@@ -32,7 +32,7 @@ class LazySession:
             if self._session is None:
                 from roc.ros.client import Session
 
-                self._session = Session(use_daemon=self.use_daemon, spin_time=self.spin_time)
+                self._session = Session(use_daemon=self.use_daemon, spin_time=self.spin_time, long_lived=True)
             return self._session
 
     def query(self, *args, **kwargs):

@@ -122,9 +122,9 @@ def _start_lock(path: Path):
         yield
 
 
-def _usable(connection: Connection) -> bool:
+def _usable(connection: Connection, timeout: float = 10) -> bool:
     """The daemon is of this roc version and serves this discovery environment; else it is stopped."""
-    hello = connection.request("hello", timeout=10)
+    hello = connection.request("hello", timeout=timeout)
     if hello.get("version") == __version__ and hello.get("environment") == discovery_environment():
         return True
     try:
@@ -135,36 +135,86 @@ def _usable(connection: Connection) -> bool:
     return False
 
 
-def start_daemon() -> Connection:
-    """The running daemon, started if there is none: detached in a process group of its own, so the
-    terminal's Ctrl+C and hang-up do not reach it, but in the caller's session. A session of its own
-    is a scheduling group of its own on Linux (autogroup): on a busy machine the daemon then went
-    without CPU for up to 3.6 s at a time, and echo lost 10-35 k of 50 k messages at 5 kHz where it
-    now loses 0-2.5 k (bench/dataplane_bench.py)."""
+def running_daemon(path: Path | None = None, hello_timeout: float = 10) -> Connection | None:
+    """A connection to this environment's daemon when one of this roc version runs, else None (one of
+    another version or environment is told to stop)."""
+    connection = connect(path or socket_path())
+    if connection is None:
+        return None
+    try:
+        usable = _usable(connection, hello_timeout)
+    except BaseException:
+        connection.close()
+        raise
+    return connection if usable else None
+
+
+def spawn_daemon() -> None:
+    """Start this environment's daemon unless one runs, without waiting for it (as ``ros2`` does). The
+    socket is bound, listening, here and handed to the daemon, so the path takes connections from
+    now on: a client's requests wait in its backlog until the daemon serves them.
+
+    The daemon runs detached in a process group of its own, so the terminal's Ctrl+C and hang-up do
+    not reach it, but in the caller's session. A session of its own is a scheduling group of its own
+    on Linux (autogroup): on a busy machine the daemon then went without CPU for up to 3.6 s at a
+    time, and echo lost 10-35 k of 50 k messages at 5 kHz where it now loses 0-2.5 k
+    (bench/dataplane_bench.py)."""
     path = socket_path()
-    connection = connect(path)
-    if connection and _usable(connection):
-        return connection
     with _start_lock(path):
-        connection = connect(path)
-        if connection and _usable(connection):
-            return connection
+        connection = running_daemon(path)
+        if connection is not None:
+            connection.close()
+            return
         _wait_gone(path)
+        listener = _listen(path)
         import subprocess
 
-        log = open(path.with_suffix(".log"), "ab")
-        # not one of a roc launch's processes, even when one of them starts it (roc/launch/guard.py's token)
-        env = {name: value for name, value in os.environ.items() if name != "ROC_LAUNCH_ID"}
-        subprocess.Popen([sys.executable, "-m", "roc.ros.daemon", str(path)], stdin=subprocess.DEVNULL,
-                         stdout=log, stderr=log, process_group=0, close_fds=True, env=env)
-        log.close()
-        deadline = time.monotonic() + START_TIMEOUT
-        while time.monotonic() < deadline:
-            connection = connect(path)
-            if connection:
-                return connection
-            time.sleep(0.02)
-    raise RocError(f"the roc daemon did not start within {START_TIMEOUT:g} s; see {path.with_suffix('.log')}")
+        try:
+            with open(path.with_suffix(".log"), "ab") as log:
+                # not one of a roc launch's processes, even when one of them starts it (roc/launch/guard.py's token)
+                env = {name: value for name, value in os.environ.items() if name != "ROC_LAUNCH_ID"}
+                subprocess.Popen([sys.executable, "-m", "roc.ros.daemon", str(path), str(listener.fileno())],
+                                 stdin=subprocess.DEVNULL, stdout=log, stderr=log, process_group=0,
+                                 pass_fds=(listener.fileno(),), env=env)
+        except BaseException:
+            path.unlink(missing_ok=True)
+            raise
+        finally:
+            listener.close()
+
+
+def _listen(path: Path) -> socket.socket:
+    """A socket listening at ``path``, mode 0600. Bound under a temporary name and renamed into place,
+    so a client never finds the path refusing connections (it would take it for a dead daemon's
+    socket and remove it)."""
+    listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    staging = path.with_name(f".{path.name}.{os.getpid()}")
+    staging.unlink(missing_ok=True)
+    old_umask = os.umask(0o177)
+    try:
+        listener.bind(str(staging))
+    finally:
+        os.umask(old_umask)
+    listener.listen(64)
+    os.replace(staging, path)
+    return listener
+
+
+def start_daemon() -> Connection:
+    """A connection to this environment's daemon, started if none runs; it answers once the daemon
+    serves (its first graph answer waits for its discovery)."""
+    connection = running_daemon()
+    if connection is not None:
+        return connection
+    spawn_daemon()
+    try:
+        connection = running_daemon(hello_timeout=START_TIMEOUT)
+    except RocError:
+        connection = None
+    if connection is None:
+        log = socket_path().with_suffix(".log")
+        raise RocError(f"the roc daemon did not start within {START_TIMEOUT:g} s; see {log}")
+    return connection
 
 
 def _wait_gone(path: Path, timeout: float = 5.0) -> None:
@@ -223,12 +273,10 @@ def all_daemon_statuses() -> list[dict[str, Any]]:
 def query_running_daemon(method: str, params: dict[str, Any] | None = None) -> Any:
     """Answer a graph request through this environment's daemon if one is running (never starting one:
     for lookups that are worth a warm graph's answer but not a cold discovery's wait); None when none runs."""
-    connection = connect(socket_path())
+    connection = running_daemon()
     if connection is None:
         return None
     try:
-        if not _usable(connection):
-            return None
         return connection.request(method, params or {})
     finally:
         connection.close()
@@ -236,15 +284,12 @@ def query_running_daemon(method: str, params: dict[str, Any] | None = None) -> A
 
 def query(method: str, params: dict[str, Any] | None = None, *, use_daemon: bool = True,
           spin_time: float | None = None) -> Any:
-    """Answer a graph request, through the daemon unless ``use_daemon`` is false."""
-    params = params or {}
-    if not use_daemon:
-        return _in_process().query(method, params, spin_time)
-    connection = start_daemon()
+    """Answer a graph request (on a Session: through the running daemon, else in this process)."""
+    session = Session(use_daemon, spin_time)
     try:
-        return connection.request(method, params)
+        return session.query(method, params)
     finally:
-        connection.close()
+        session.close()
 
 
 def stream(method: str, params: dict[str, Any], *, use_daemon: bool = True, heartbeats: bool = False,
@@ -278,21 +323,33 @@ def stream(method: str, params: dict[str, Any], *, use_daemon: bool = True, hear
 
 
 class Session:
-    """Many queries and streams on one participant: the daemon's, or (``use_daemon`` false) one of
-    this process, discovered once (see roc.ros.graph.Graph). For callers that probe a graph many
-    times, e.g. ``roc graph check``; thread-safe."""
+    """Queries and streams on one participant: the running daemon's, or else one of this process,
+    discovered once (see roc.ros.graph.Graph); then the daemon is started as the session closes, for
+    the next verb. So a cold verb is no slower than with ``--no-daemon``, which never starts one (as
+    ``ros2`` does). A ``long_lived`` session (a launch's probes, the TUI) starts the daemon and
+    waits for it instead. Thread-safe."""
 
-    def __init__(self, use_daemon: bool = True, spin_time: float | None = None):
+    def __init__(self, use_daemon: bool = True, spin_time: float | None = None, long_lived: bool = False):
         self.graph = None  # None: through the daemon
-        if use_daemon:
+        self.start_daemon_on_close = False
+        if use_daemon and long_lived:
             start_daemon().close()
-        else:
-            self.graph = _in_process().discovered_graph(spin_time)
+            return
+        connection = running_daemon() if use_daemon else None
+        if connection is not None:
+            connection.close()
+            return
+        self.graph = _in_process().discovered_graph(spin_time)
+        self.start_daemon_on_close = use_daemon
 
     def query(self, method: str, params: dict[str, Any] | None = None) -> Any:
         if self.graph is not None:
             return self.graph.handle(method, params or {})
-        return query(method, params)
+        connection = start_daemon()
+        try:
+            return connection.request(method, params or {})
+        finally:
+            connection.close()
 
     def stream(self, method: str, params: dict[str, Any], heartbeats: bool = False) -> Events:
         if self.graph is None:
@@ -304,6 +361,9 @@ class Session:
     def close(self) -> None:
         if self.graph is not None:
             self.graph.close()
+        if self.start_daemon_on_close:
+            self.start_daemon_on_close = False
+            spawn_daemon()
 
 
 def _in_process():

@@ -1,6 +1,6 @@
 """The roc daemon: one warm graph participant per user and discovery environment, answering JSON-line
-requests on a Unix socket (mode 0600). Started by roc.ros.client; run as
-``python -m roc.ros.daemon SOCKET``. The protocol is in docs/daemon.md.
+requests on a Unix socket (mode 0600). Started by roc.ros.client.spawn_daemon, which binds the
+socket and hands it over: ``python -m roc.ros.daemon SOCKET FD``. The protocol is in docs/daemon.md.
 """
 
 from __future__ import annotations
@@ -48,20 +48,8 @@ class Daemon:
         self.graph: Any = None  # the roc.ros.graph.Graph, once created (imported then: rclpy is slow to load)
         self.started = time.time()
 
-    def serve(self) -> None:
-        # Bound and listening under a temporary name, then renamed into place: a client never finds
-        # the path refusing connections (it would take it for a dead daemon's socket and remove it).
-        listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
-        staging = self.path.with_name(f".{self.path.name}.{os.getpid()}")
-        staging.unlink(missing_ok=True)
-        old_umask = os.umask(0o177)
-        try:
-            listener.bind(str(staging))
-        finally:
-            os.umask(old_umask)
-        os.chmod(staging, 0o600)
-        listener.listen(64)
-        os.replace(staging, self.path)
+    def serve(self, listener: socket.socket) -> None:
+        """Serve on ``listener``, bound at ``self.path`` and listening (roc.ros.client.spawn_daemon)."""
         self._inode = self.path.stat().st_ino
         listener.settimeout(0.5)
         threading.Thread(target=self._discover, daemon=True).start()
@@ -149,13 +137,13 @@ class Daemon:
 
 
 def main() -> None:
-    path = Path(sys.argv[1])
+    path, listener_fd = Path(sys.argv[1]), int(sys.argv[2])
     daemon = Daemon(path)
     signal.signal(signal.SIGTERM, lambda *_: daemon.stopping.set())
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGHUP, signal.SIG_IGN)  # it outlives the terminal that started it
     os.chdir("/")
-    daemon.serve()
+    daemon.serve(socket.socket(fileno=listener_fd))
 
 
 if __name__ == "__main__":

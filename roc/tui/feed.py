@@ -57,7 +57,7 @@ class Feed:
     def session(self) -> Session:
         with self._lock:
             if self._session is None:
-                self._session = Session()
+                self._session = Session(long_lived=True)
             return self._session
 
     def query(self, method: str, params: dict[str, Any] | None = None) -> Any:

@@ -73,6 +73,30 @@ def test_lifecycle(talker):
                                                                                             "count": 0}
 
 
+SESSION_WITHOUT_DAEMON = """
+import json
+from roc.ros.client import Session, daemon_status
+session = Session()
+running_during = daemon_status() is not None
+nodes = [node["full_name"] for node in session.query("snapshot")["nodes"]]
+session.close()
+after = daemon_status()
+print(json.dumps({"running_during": running_during, "nodes": nodes, "pid_after": after and after["pid"]}))
+"""
+
+
+def test_without_a_daemon_a_verb_answers_in_its_process_and_leaves_a_daemon_for_the_next(talker):
+    """As ros2 does: a cold verb does not wait for a daemon to start and discover; it discovers in its
+    own process and starts the daemon as it ends."""
+    ran = subprocess.run([sys.executable, "-c", SESSION_WITHOUT_DAEMON], env=talker, capture_output=True,
+                         text=True, timeout=60, cwd=Path(__file__).parents[2])
+    assert ran.returncode == 0, ran.stderr
+    result = json.loads(ran.stdout)
+    assert result["running_during"] is False and result["nodes"] == ["/talker"]
+    assert result["pid_after"] == status(talker)["pid"]
+    assert roc("node", "list", env=talker).stdout == "/talker\n"  # the daemon's answer now
+
+
 def test_the_daemon_is_out_of_the_terminal_s_reach_but_in_its_session(talker):
     """Its own process group: the terminal's Ctrl+C goes to the foreground group only; hang-up is
     ignored. The caller's session: a session of its own is a scheduling group of its own on Linux,
