@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 import queue
+import socket
 import subprocess
 import sys
 import threading
@@ -212,8 +213,16 @@ def stop_daemon(env: dict[str, str]) -> None:
             os.kill(pid, 9)
         except ProcessLookupError:
             pass
-    if (ORACLE_VENV / "bin" / "ros2").exists():  # the oracle may have started its daemon in this domain
+    if ros2_daemon_listens(env):  # the oracle started its daemon in this domain
         ros2("daemon", "stop", env=env)
+
+
+def ros2_daemon_listens(env: dict[str, str]) -> bool:
+    """A ros2 daemon serves ``env``'s domain: it listens on 127.0.0.1, port 11511 + ROS_DOMAIN_ID
+    (ros2cli.daemon.get_port). Asked before ``ros2 daemon stop``, which takes half a second to start."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        probe.settimeout(1)
+        return probe.connect_ex(("127.0.0.1", 11511 + int(env.get("ROS_DOMAIN_ID") or 0))) == 0
 
 
 def assert_call_and_goal_work(env: dict[str, str]) -> None:
