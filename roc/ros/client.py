@@ -12,6 +12,7 @@ import json
 import os
 import socket
 import sys
+import threading
 import time
 import zlib
 from contextlib import contextmanager
@@ -332,20 +333,22 @@ class Session:
     def __init__(self, use_daemon: bool = True, spin_time: float | None = None, long_lived: bool = False):
         self.graph = None  # None: through the daemon
         self.start_daemon_on_close = False
-        if use_daemon and long_lived:
-            start_daemon().close()
-            return
-        connection = running_daemon() if use_daemon else None
-        if connection is not None:
-            connection.close()
-            return
+        self._lock = threading.Lock()
+        # the connection that found the daemon, for the first query (a one-shot verb's only one)
+        self._first: Connection | None = None
+        if use_daemon:
+            self._first = start_daemon() if long_lived else running_daemon()
+            if self._first is not None:
+                return
         self.graph = _in_process().discovered_graph(spin_time)
         self.start_daemon_on_close = use_daemon
 
     def query(self, method: str, params: dict[str, Any] | None = None) -> Any:
         if self.graph is not None:
             return self.graph.handle(method, params or {})
-        connection = start_daemon()
+        with self._lock:
+            connection, self._first = self._first, None
+        connection = connection or start_daemon()
         try:
             return connection.request(method, params or {})
         finally:
@@ -359,6 +362,10 @@ class Session:
         yield from (e for e in events if heartbeats or e.get("event") != "heartbeat")
 
     def close(self) -> None:
+        with self._lock:
+            connection, self._first = self._first, None
+        if connection is not None:
+            connection.close()
         if self.graph is not None:
             self.graph.close()
         if self.start_daemon_on_close:
