@@ -9,10 +9,11 @@ Two facts make the local part exact:
   prefix carries the writer's host id (bytes 2-3) and process id (bytes 4-5, little-endian), so the
   writers seen tell which of those participants have been discovered.
 
-A participant discovered has not necessarily told its nodes yet (its ``ros_discovery_info`` message
-comes after its writer, under load 0.1 s and more later): it is heard once one of its endpoints has a
-node name, or, for roc's own participants (which have no endpoints), once a node named for its process
-is known (``unheard_participants``).
+A participant discovered is not wholly known yet: its nodes come in its ``ros_discovery_info`` message
+(under load 0.1 s and more after its writer), and each endpoint in an announcement of its own, which
+may come later still. It is once its message has come and every node and endpoint GID the message
+lists has been discovered (``incomplete_participants``; the message is read by
+roc.ros.discovery_info).
 
 A fresh participant's first announcement goes out before Fast DDS listens, so it would hear some of
 them only at their next periodic announcement: it asks them to announce themselves again
@@ -27,10 +28,11 @@ from __future__ import annotations
 
 import os
 import socket
+from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from roc.ros.protocol import OWN_NODE_PREFIX, is_own_node
 from roc.ros.spdp import stand_in_announcement
 
 PORT_BASE = 7400
@@ -138,15 +140,27 @@ def discovered_local_peers(writers: list[Any], pid: int) -> int | None:
     return sum(1 for p in prefixes - own if process_bits(p) is not None and p[2:4] == host)
 
 
-def unheard_participants(writers: list[Any], endpoints: list[Any], node_names: list[str], pid: int) -> int:
-    """How many participants of other processes whose ``ros_discovery_info`` writer is among ``writers``
-    have not told their nodes yet: none of ``endpoints`` (rclpy endpoint infos of every topic) with their
-    GUID prefix has a node name, and no node of roc's own in ``node_names`` is named for their process."""
-    told = {bytes(info.endpoint_gid)[:12] for info in endpoints if info.node_name != UNKNOWN_NODE}
-    roc_processes = {int(name[len(OWN_NODE_PREFIX):]) & 0xFFFF for name in node_names if is_own_node(name)}
-    unheard = 0
-    for prefix in {bytes(info.endpoint_gid)[:12] for info in writers}:
-        process = process_bits(prefix)
-        if process != pid & 0xFFFF and prefix not in told and process not in roc_processes:
-            unheard += 1
-    return unheard
+@dataclass(frozen=True)
+class Told:
+    """What a participant's latest ``ros_discovery_info`` message lists (roc.ros.discovery_info): its
+    nodes as (namespace, name) and the GIDs of their endpoints."""
+
+    nodes: frozenset[tuple[str, str]]
+    endpoints: frozenset[bytes]
+
+
+def incomplete_participants(writers: list[Any], told: Mapping[bytes, Told], endpoints: set[bytes],
+                            nodes: set[tuple[str, str]], pid: int) -> int:
+    """How many participants of other processes, whose ``ros_discovery_info`` writer is among ``writers``
+    (rclpy endpoint infos), are not wholly discovered yet: their writer's message (``told``, by writer
+    GID) has not come, or it lists a node not among ``nodes`` (namespace, name) or an endpoint whose
+    GID is not among ``endpoints``."""
+    incomplete = 0
+    for info in writers:
+        gid = bytes(info.endpoint_gid)
+        if process_bits(gid[:12]) == pid & 0xFFFF:
+            continue
+        latest = told.get(gid)
+        if latest is None or not latest.nodes <= nodes or not latest.endpoints <= endpoints:
+            incomplete += 1
+    return incomplete

@@ -30,11 +30,13 @@ from roc.errors import RocError
 from roc.ros.discovery import (
     DISCOVERY_TOPIC,
     UNKNOWN_NODE,
+    Told,
     ask_local_participants_to_announce,
     discovered_local_peers,
+    incomplete_participants,
     local_participant_count,
-    unheard_participants,
 )
+from roc.ros.discovery_info import DiscoveryInfoReader
 from roc.ros.params import WRITES, parameter_value
 from roc.ros.protocol import (
     DEFAULT_SPIN_TIME,
@@ -42,19 +44,21 @@ from roc.ros.protocol import (
     discovery_stays_local,
     full_name,
     is_own_node,
+    middleware,
     own_node_name,
 )
 from roc.ros.raw_subscription import gid_text
 from roc.ros.type_description import describe
 
-# A fresh participant's discovery ends as soon as it has heard every participant of this host in its domain
-# (roc.ros.discovery counts them), knows every endpoint's node, and the graph has been quiet for
-# QUIET_SECONDS (LOCAL_QUIET_SECONDS when discovery stays on this host: nothing is left to hear then but
-# the rest of a participant's endpoints); at the latest after the period (``--spin-time``, default
-# DEFAULT_SPIN_TIME, in roc.ros.protocol so that verbs can read it without rclpy: one Fast DDS
-# announcement period and a margin, all a participant could wait before; without --spin-time, one more
-# announcement period while the graph is known to be incomplete). Measured with ten processes:
-# complete in 20 of 20 runs, where a fixed 3.5 s was needed before.
+# A fresh participant's discovery ends as soon as it has heard every participant of this host in its
+# domain (roc.ros.discovery counts them), has discovered every node and endpoint each participant lists
+# in its ros_discovery_info message (roc.ros.discovery_info), and the graph has been quiet for
+# QUIET_SECONDS (LOCAL_QUIET_SECONDS when discovery stays on this host: no other host's participant can
+# come then); at the latest after the period (``--spin-time``, default DEFAULT_SPIN_TIME, in
+# roc.ros.protocol so that verbs can read it without rclpy: one Fast DDS announcement period and a
+# margin, all a participant could wait before; without --spin-time, one more announcement period while
+# the graph is known to be incomplete). Measured with ten processes: complete in 20 of 20 runs, where a
+# fixed 3.5 s was needed before.
 QUIET_SECONDS = 0.3
 LOCAL_QUIET_SECONDS = 0.1
 ANNOUNCEMENT_SECONDS = 3.0  # Fast DDS's default period of a participant's announcements
@@ -136,11 +140,6 @@ def users_profile(environment: Mapping[str, str] = os.environ) -> str | None:
                  if environment.get(v) and environment[v] not in OWN_PROFILES), None)
 
 
-def middleware(environment: Mapping[str, str] = os.environ) -> str:
-    """The RMW implementation rcl will load (Fast DDS unless RMW_IMPLEMENTATION says otherwise)."""
-    return environment.get("RMW_IMPLEMENTATION") or "rmw_fastrtps_cpp"
-
-
 def use_profile(profile: Path, environment: MutableMapping[str, str] = os.environ) -> None:
     """Have Fast DDS load ``profile`` for this process's participants (it reads the file once, at the
     first), unless the user chose one or the middleware is not Fast DDS. Only through the variable this
@@ -218,33 +217,38 @@ class Graph:
                 tuple((n, tuple(t)) for n, t in sorted(node.get_service_names_and_types())))
 
     def wait_for_discovery(self, period: float | None = None) -> None:
-        """Return once this host's participants are discovered, every endpoint's node is known and the
-        graph has been unchanged for a quiet time (see QUIET_SECONDS); at the latest after ``period``.
-        Without one, after DEFAULT_SPIN_TIME, or, while the graph is known to be incomplete (a
-        participant of this host not heard yet, an endpoint's node not told yet), one more
-        announcement period (ANNOUNCEMENT_SECONDS): what a process heard only at its next periodic
-        announcement needs on a loaded machine."""
+        """Return once this host's participants are discovered, every participant discovered is wholly
+        known (see _complete) and the graph has been unchanged for a quiet time (see QUIET_SECONDS); at
+        the latest after ``period``. Without one, after DEFAULT_SPIN_TIME, or, while the graph is known
+        to be incomplete (a participant of this host not heard yet, a node or endpoint it told not
+        discovered yet), one more announcement period (ANNOUNCEMENT_SECONDS): what a process heard
+        only at its next periodic announcement needs on a loaded machine."""
         quiet = LOCAL_QUIET_SECONDS if discovery_stays_local() else QUIET_SECONDS
         bound = DEFAULT_SPIN_TIME if period is None else period
         longest = bound + ANNOUNCEMENT_SECONDS if period is None else period
         domain = self.context.get_domain_id()
-        start = last_change = time.monotonic()
-        last = self.signature()
-        while True:
-            time.sleep(POLL_SECONDS)
-            now = time.monotonic()
-            current = self.signature()
-            if current != last:
-                last, last_change = current, now
-            elapsed = now - start
-            if now - last_change < quiet and elapsed < bound:
-                continue
-            peers = self._local_peers_discovered(domain)
-            complete = peers is not False and self._complete()
-            if complete and (elapsed >= bound or (peers and now - last_change >= quiet)):
-                return
-            if elapsed >= longest:
-                return
+        reader = DiscoveryInfoReader(self.node)
+        try:
+            start = last_change = time.monotonic()
+            last = self.signature()
+            while True:
+                time.sleep(POLL_SECONDS)
+                now = time.monotonic()
+                current = self.signature()
+                told = reader.take()
+                if current != last:
+                    last, last_change = current, now
+                elapsed = now - start
+                if now - last_change < quiet and elapsed < bound:
+                    continue
+                peers = self._local_peers_discovered(domain)
+                complete = peers is not False and self._complete(told)
+                if complete and (elapsed >= bound or (peers and now - last_change >= quiet)):
+                    return
+                if elapsed >= longest:
+                    return
+        finally:
+            reader.close()
 
     def _local_peers_discovered(self, domain: int) -> bool | None:
         """Every participant of another process on this host in ``domain`` has been discovered (None
@@ -256,22 +260,22 @@ class Graph:
             return None
         return discovered >= expected
 
-    def _complete(self) -> bool:
+    def _complete(self, told: Mapping[bytes, Told]) -> bool:
         """Every endpoint's node is known (a participant seen before its node names is not complete), and
-        every participant discovered has told its nodes (roc.ros.discovery.unheard_participants)."""
+        every participant discovered is wholly known: its latest ``ros_discovery_info`` message
+        (``told``, by writer GID) has come and each node and endpoint it lists has been discovered
+        (roc.ros.discovery.incomplete_participants)."""
         node = self.node
-        writers, endpoints = [], []
+        endpoints: set[bytes] = set()
         for name, _ in node.get_topic_names_and_types(no_demangle=True):  # services' request and reply too
             found = [*node.get_publishers_info_by_topic(name, no_mangle=True),
                      *node.get_subscriptions_info_by_topic(name, no_mangle=True)]
-            if name == DISCOVERY_TOPIC:
-                writers = found  # rmw's own endpoints: never a node name
-            elif any(info.node_name == UNKNOWN_NODE for info in found):
-                return False
-            else:
-                endpoints += found
-        names = [name for name, _ in node.get_node_names_and_namespaces()]
-        return unheard_participants(writers, endpoints, names, os.getpid()) == 0
+            if name != DISCOVERY_TOPIC and any(info.node_name == UNKNOWN_NODE for info in found):
+                return False  # rmw's own endpoints, on DISCOVERY_TOPIC, never have a node name
+            endpoints.update(bytes(info.endpoint_gid) for info in found)
+        writers = node.get_publishers_info_by_topic(DISCOVERY_TOPIC, no_mangle=True)
+        nodes = {(namespace, name) for name, namespace in node.get_node_names_and_namespaces()}
+        return incomplete_participants(writers, told, endpoints, nodes, os.getpid()) == 0
 
     # -- roc's own participants (roc.ros.protocol.is_own_node) are in no answer ---------------------------
     def _nodes(self, own: bool = False) -> list[tuple[str, str]]:

@@ -16,20 +16,16 @@ import functools
 from typing import Any
 
 from roc.errors import RocError
+from roc.ros.native import Allocator, type_support
 
 RCL_RET_OK = 0
 RCL_RET_UNSUPPORTED = 3
 _SPARE = 256  # bytes after each struct roc declares: room for fields a newer rcl adds at the end
 
 
-class _Allocator(ctypes.Structure):  # rcutils_allocator_t
-    _fields_ = [("allocate", ctypes.c_void_p), ("deallocate", ctypes.c_void_p), ("reallocate", ctypes.c_void_p),
-                ("zero_allocate", ctypes.c_void_p), ("state", ctypes.c_void_p)]
-
-
 class _FilterOptions(ctypes.Structure):  # rcl_subscription_content_filter_options_t (zeroed: zero-initialized)
     _fields_ = [("filter_expression", ctypes.c_char_p), ("size", ctypes.c_size_t),
-                ("data", ctypes.POINTER(ctypes.c_char_p)), ("allocator", _Allocator),
+                ("data", ctypes.POINTER(ctypes.c_char_p)), ("allocator", Allocator),
                 ("_spare", ctypes.c_uint8 * _SPARE)]
 
 
@@ -69,12 +65,6 @@ def _error(rcutils: ctypes.CDLL) -> str:
     return text.split(", at ")[0].strip() or "no reason given"
 
 
-def _type_support(msg_type: type) -> int:
-    getter = ctypes.pythonapi.PyCapsule_GetPointer
-    getter.restype, getter.argtypes = ctypes.c_void_p, [ctypes.py_object, ctypes.c_char_p]
-    return getter(msg_type._TYPE_SUPPORT, None)  # type: ignore[attr-defined]
-
-
 def _arguments(parameters: list[str]) -> Any:
     return (ctypes.c_char_p * max(len(parameters), 1))(*[p.encode() for p in parameters])
 
@@ -88,7 +78,7 @@ def _refusal(node, msg_type: type, topic: str, expression: str, parameters: list
         return _error(rcutils)
     probe = ctypes.c_void_p()  # rcl_subscription_t: one pointer, zero-initialized
     with node.handle:
-        result = rcl.rcl_subscription_init(ctypes.byref(probe), node.handle.pointer, _type_support(msg_type),
+        result = rcl.rcl_subscription_init(ctypes.byref(probe), node.handle.pointer, type_support(msg_type),
                                            topic.encode(), ctypes.byref(options))
         if result != RCL_RET_OK:
             refused = _error(rcutils)

@@ -54,6 +54,12 @@ def discovery_range(env: Mapping[str, str] | None = None) -> str:
     return env.get("ROS_AUTOMATIC_DISCOVERY_RANGE") or "SUBNET"
 
 
+def middleware(environment: Mapping[str, str] | None = None) -> str:
+    """The RMW implementation rcl will load (Fast DDS unless RMW_IMPLEMENTATION says otherwise)."""
+    environment = os.environ if environment is None else environment
+    return environment.get("RMW_IMPLEMENTATION") or "rmw_fastrtps_cpp"
+
+
 def discovery_stays_local(env: Mapping[str, str] | None = None) -> bool:
     """Discovery reaches no other host: the LOCALHOST (or OFF) range without static peers."""
     env = os.environ if env is None else env

@@ -24,10 +24,9 @@ from rclpy.qos import QoSProfile
 from rclpy.type_support import check_is_valid_msg_type
 
 from roc.errors import RocError
+from roc.ros.native import RET_OK, MessageInfo, SerializedMessage, free_serialized_message, serialized_message
 
-RCL_RET_OK = 0
 RCL_RET_SUBSCRIPTION_TAKE_FAILED = 401  # nothing to take
-GID_SIZE = 16  # RMW_GID_STORAGE_SIZE of Jazzy's rmw
 SEQUENCE_UNSUPPORTED = 2**64 - 1  # RMW_MESSAGE_INFO_SEQUENCE_NUMBER_UNSUPPORTED
 MAX_TAKE = 1000  # messages taken from one subscription before the others get their turn
 MAX_QUEUED_BYTES = 64 * 2**20  # taken messages a Receiver holds for a slow reader
@@ -37,39 +36,13 @@ GATHER_SECONDS = 0.002
 WAIT_NANOSECONDS = 1_000_000_000  # a Receiver's longest wait in rcl (close wakes it at once)
 
 
-class _Allocator(ctypes.Structure):  # rcutils_allocator_t
-    _fields_ = [("allocate", ctypes.c_void_p), ("deallocate", ctypes.c_void_p), ("reallocate", ctypes.c_void_p),
-                ("zero_allocate", ctypes.c_void_p), ("state", ctypes.c_void_p)]
-
-
-class _Bytes(ctypes.Structure):  # rcutils_uint8_array_t (rmw_serialized_message_t)
-    _fields_ = [("buffer", ctypes.POINTER(ctypes.c_uint8)), ("buffer_length", ctypes.c_size_t),
-                ("buffer_capacity", ctypes.c_size_t), ("allocator", _Allocator)]
-
-
-class _Gid(ctypes.Structure):  # rmw_gid_t
-    _fields_ = [("implementation_identifier", ctypes.c_char_p), ("data", ctypes.c_uint8 * GID_SIZE)]
-
-
-class _Info(ctypes.Structure):  # rmw_message_info_t
-    _fields_ = [("source_timestamp", ctypes.c_int64), ("received_timestamp", ctypes.c_int64),
-                ("publication_sequence_number", ctypes.c_uint64), ("reception_sequence_number", ctypes.c_uint64),
-                ("publisher_gid", _Gid), ("from_intra_process", ctypes.c_bool)]
-
-
 @functools.cache
-def _libraries() -> tuple[ctypes.CDLL, ctypes.CDLL]:
-    """librcl and librcutils as rclpy loaded them (dlopen finds a loaded library by its name). As
-    PyDLLs, whose calls keep Python's lock: a take is a copy, and releasing the lock around each one
-    lets any busy thread of the process hold it for a switch interval (5 ms) per message taken."""
-    rcl, rcutils = ctypes.PyDLL("librcl.so"), ctypes.PyDLL("librcutils.so")
-    rcutils.rcutils_get_default_allocator.restype = _Allocator
-    rcutils.rcutils_uint8_array_init.argtypes = [ctypes.POINTER(_Bytes), ctypes.c_size_t, ctypes.POINTER(_Allocator)]
-    rcutils.rcutils_uint8_array_fini.argtypes = [ctypes.POINTER(_Bytes)]
-    rcl.rcl_take_serialized_message.argtypes = [ctypes.c_void_p, ctypes.POINTER(_Bytes), ctypes.POINTER(_Info),
-                                                ctypes.c_void_p]
+def _rcl() -> ctypes.CDLL:
+    rcl = ctypes.PyDLL("librcl.so")
+    rcl.rcl_take_serialized_message.argtypes = [ctypes.c_void_p, ctypes.POINTER(SerializedMessage),
+                                                ctypes.POINTER(MessageInfo), ctypes.c_void_p]
     rcl.rcl_take_serialized_message.restype = ctypes.c_int32
-    return rcl, rcutils
+    return rcl
 
 
 def gid_text(gid) -> str:
@@ -83,7 +56,7 @@ def _known_gid_text(gid: bytes) -> str:
     return gid_text(gid)
 
 
-def _info(info: _Info) -> dict[str, Any]:
+def _info(info: MessageInfo) -> dict[str, Any]:
     """The message info as rclpy names it, plus ``gid`` (the publisher's, as ``gid_text``); an
     unsupported sequence number is None."""
     return {"source_timestamp": info.source_timestamp, "received_timestamp": info.received_timestamp,
@@ -102,7 +75,7 @@ class RawSubscription:
     def __init__(self, node, msg_type: type, topic: str, qos: QoSProfile,
                  content_filter: tuple[str, list[str]] | None = None) -> None:
         check_is_valid_msg_type(msg_type)
-        self._rcl, self._rcutils = _libraries()
+        self._rcl = _rcl()
         with node.handle:
             self._handle = _rclpy.Subscription(node.handle, msg_type, topic, qos.get_c_qos_profile())
         self.unfiltered: str | None = None
@@ -110,11 +83,11 @@ class RawSubscription:
             from roc.ros.middleware_filter import set_filter
 
             self.unfiltered = set_filter(node, self._handle, msg_type, topic, *content_filter)
-        self._buffer = _Bytes()
-        allocator = self._rcutils.rcutils_get_default_allocator()
-        if self._rcutils.rcutils_uint8_array_init(ctypes.byref(self._buffer), 0, ctypes.byref(allocator)) != RCL_RET_OK:
+        try:
+            self._buffer = serialized_message()
+        except RocError:
             self._handle.destroy_when_not_in_use()
-            raise RocError("cannot allocate a buffer for serialized messages")
+            raise
 
     @property
     def handle(self):
@@ -124,19 +97,19 @@ class RawSubscription:
         """Up to ``most`` messages waiting, oldest first."""
         taken: list[tuple[bytes, dict[str, Any]]] = []
         while len(taken) < most:
-            info = _Info()
+            info = MessageInfo()
             result = self._rcl.rcl_take_serialized_message(self._handle.pointer, ctypes.byref(self._buffer),
                                                            ctypes.byref(info), None)
             if result == RCL_RET_SUBSCRIPTION_TAKE_FAILED:
                 break
-            if result != RCL_RET_OK:
+            if result != RET_OK:
                 raise RocError(f"rcl_take_serialized_message failed ({result})")
-            taken.append((ctypes.string_at(self._buffer.buffer, self._buffer.buffer_length), _info(info)))
+            taken.append((self._buffer.data(), _info(info)))
         return taken
 
     def destroy(self) -> None:
         self._handle.destroy_when_not_in_use()
-        self._rcutils.rcutils_uint8_array_fini(ctypes.byref(self._buffer))
+        free_serialized_message(self._buffer)
 
 
 class Receiver:

@@ -1,26 +1,30 @@
-"""How a fresh participant knows its graph is complete (roc.ros.discovery) and how it asks this host's
-participants to announce themselves (roc.ros.spdp): unit tests on made-up /proc tables and GUIDs, and a
-real Fast DDS participant answering the stand-in's announcement."""
+"""How a fresh participant knows its graph is complete (roc.ros.discovery, roc.ros.discovery_info) and
+how it asks this host's participants to announce themselves (roc.ros.spdp): unit tests on made-up /proc
+tables and GUIDs; real participants telling their nodes and endpoints on ros_discovery_info; a real
+Fast DDS participant answering the stand-in's announcement."""
 
 from __future__ import annotations
 
+import json
 import socket
 import struct
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
-from helpers.graph import graph_env, roc, start_nodes, stop_all
+from helpers.graph import NODE_SCRIPT, graph_env, read_line, roc, start_nodes, stop_all
 
 from roc import distribution
 from roc.ros.discovery import (
-    UNKNOWN_NODE,
+    Told,
     ask_local_participants_to_announce,
     discovered_local_peers,
+    incomplete_participants,
     local_participant_count,
     metatraffic_sockets,
     own_socket_inodes,
     process_bits,
-    unheard_participants,
 )
 from roc.ros.spdp import SPDP_WRITER, stand_in_announcement
 
@@ -60,24 +64,30 @@ def test_discovered_peers_are_the_other_fast_dds_participants_of_this_host() -> 
     assert discovered_local_peers(writers[1:], pid) is None  # this process's own writer not seen yet
 
 
-class Endpoint(Writer):
-    def __init__(self, prefix_hex: str, node_name: str):
-        super().__init__(prefix_hex)
-        self.node_name = node_name
+def _told(nodes: list[str], endpoints: list[str]) -> Told:
+    return Told(nodes=frozenset(("/", name) for name in nodes),
+                endpoints=frozenset(bytes.fromhex(gid) for gid in endpoints))
 
 
-def test_a_participant_is_heard_once_an_endpoint_has_its_node_or_a_roc_node_names_its_process() -> None:
+def test_a_participant_is_wholly_known_once_its_message_has_come_and_all_it_lists_is_discovered() -> None:
     pid = 0x7322
-    ours, talker, listener, roc_daemon = ("010f7f01" "2273" "2073" "00000000", "010f7f01" "8272" "ae01" "00000000",
-                                          "010f7f01" "8272" "b001" "00000000", "010f7f01" "3412" "9999" "00000000")
-    writers = [Writer(prefix) for prefix in (ours, talker, listener, roc_daemon)]
-    # the talker's node is told; the listener's endpoints are seen before its node; roc's daemon has none
-    endpoints = [Endpoint(talker, "talker"), Endpoint(listener, UNKNOWN_NODE)]
-    assert unheard_participants(writers, endpoints, ["talker"], pid) == 2
-    assert unheard_participants(writers, endpoints, ["talker", f"_roc_{0x11234}"], pid) == 1  # pid's low 16 bits
-    endpoints.append(Endpoint(listener, "listener"))
-    assert unheard_participants(writers, endpoints, ["talker", "listener", f"_roc_{0x1234}"], pid) == 0
-    assert unheard_participants(writers, [], [], pid) == 3  # nothing told yet: only this process's own is not waited for
+    ours, talker, listener = ("010f7f01" "2273" "2073" "00000000", "010f7f01" "8272" "ae01" "00000000",
+                              "010f7f01" "8272" "b001" "00000000")
+    writers = [Writer(prefix) for prefix in (ours, talker, listener)]
+    gid = {writer: bytes(writer.endpoint_gid) for writer in writers}
+    talker_pub, listener_sub = talker + "00000103", listener + "00000104"
+    told = {gid[writers[1]]: _told(["talker"], [talker_pub]), gid[writers[2]]: _told(["listener"], [listener_sub])}
+    nodes = {("/", "talker"), ("/", "listener")}
+    endpoints = {bytes.fromhex(talker_pub), bytes.fromhex(listener_sub)}
+    assert incomplete_participants(writers, told, endpoints, nodes, pid) == 0
+    # the listener's subscription is told but not discovered yet: only the listener is incomplete
+    assert incomplete_participants(writers, told, {bytes.fromhex(talker_pub)}, nodes, pid) == 1
+    # a node told that the graph does not show yet
+    assert incomplete_participants(writers, told, endpoints, {("/", "talker")}, pid) == 1
+    # no message from the listener's writer yet; this process's own writer is never waited for
+    assert incomplete_participants(writers, {gid[writers[1]]: told[gid[writers[1]]]}, endpoints, nodes, pid) == 1
+    assert incomplete_participants(writers, {}, set(), set(), pid) == 2
+    assert incomplete_participants(writers, {}, set(), set(), 0x1111) == 3  # another process: ours is a peer
 
 
 def _locator(address: str, port: int) -> bytes:
@@ -181,3 +191,90 @@ def test_a_first_query_hears_processes_that_announce_themselves_once_a_minute(tm
             assert listed.stdout.split() == names, listed.stderr
     finally:
         stop_all(processes)
+
+
+# In a process of its own: what roc's ros_discovery_info reader tells of the talker's participant, beside
+# what the rmw graph cache shows of the talker's endpoints once it has discovered them all
+TOLD_AND_DISCOVERED = """
+import json, time
+from roc.ros.discovery_info import DiscoveryInfoReader
+from roc.ros.graph import Graph
+
+graph = Graph()
+reader = DiscoveryInfoReader(graph.node)
+node = graph.node
+deadline = time.monotonic() + 20
+while True:
+    told = [t for t in reader.take().values() if ("/", "talker") in t.nodes]
+    discovered = {bytes(info.endpoint_gid).hex()
+                  for name, _ in node.get_topic_names_and_types(no_demangle=True)
+                  for info in (*node.get_publishers_info_by_topic(name, no_mangle=True),
+                               *node.get_subscriptions_info_by_topic(name, no_mangle=True))
+                  if info.node_name == "talker"}
+    if told and {gid.hex() for gid in told[0].endpoints} == discovered or time.monotonic() > deadline:
+        break
+    time.sleep(0.1)
+reader.close()
+graph.close()
+print(json.dumps({"told": [{"nodes": sorted(t.nodes), "endpoints": sorted(gid.hex() for gid in t.endpoints)}
+                           for t in told], "discovered": sorted(discovered)}))
+"""
+
+
+@pytest.mark.distro
+def test_a_participant_tells_on_ros_discovery_info_each_endpoint_the_graph_discovers_for_its_node(tmp_path: Path) -> None:
+    """rmw's graph cache, reading the same messages, is the oracle: the GIDs roc's reader is told for the
+    talker are those of the talker's endpoints the middleware discovered."""
+    env = graph_env(SLOT, tmp_path)
+    processes = start_nodes([{"name": "talker", "publishers": [{"topic": "chatter", "type": "std_msgs/msg/String"}],
+                              "services": [{"name": "reset", "type": "std_srvs/srv/Trigger"}]}], env)
+    try:
+        ran = subprocess.run([sys.executable, "-c", TOLD_AND_DISCOVERED], env=env, capture_output=True, text=True,
+                             timeout=60)
+    finally:
+        stop_all(processes)
+    assert ran.returncode == 0, ran.stderr
+    seen = json.loads(ran.stdout)
+    [told] = seen["told"]
+    assert told["nodes"] == [["/", "talker"]]
+    # rosout, parameter events, chatter, and the requests and replies of reset and the parameter services
+    assert len(seen["discovered"]) > 10
+    assert told["endpoints"] == seen["discovered"]
+
+
+# In a process of its own: how long a fresh participant's discovery waits, at most 2 s, and the nodes it sees
+FIRST_DISCOVERY = """
+import json, time
+from roc.ros.graph import Graph
+
+graph = Graph()
+start = time.monotonic()
+graph.wait_for_discovery(2.0)
+waited = time.monotonic() - start
+nodes = sorted(name for name, _ in graph.node.get_node_names_and_namespaces())
+graph.close()
+print(json.dumps({"waited": waited, "nodes": nodes}))
+"""
+
+
+@pytest.mark.distro
+def test_a_first_query_waits_for_an_endpoint_a_participant_told_but_never_announced(tmp_path: Path) -> None:
+    """A late endpoint, made lasting: node /ghost is told with a writer no participant announces. Every
+    other sign of a complete graph holds (each participant heard, each endpoint's node known), so
+    only the endpoints told keep the wait going, to its end."""
+    env = graph_env(SLOT, tmp_path)
+    processes = start_nodes([{"name": "talker", "publishers": [{"topic": "chatter", "type": "std_msgs/msg/String"}]}],
+                            env)
+    teller = subprocess.Popen([sys.executable, str(NODE_SCRIPT.with_name("ghost_teller.py"))], env=env,
+                              stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    processes.append(teller)
+    try:
+        assert read_line(teller) == "ready\n"
+        ran = subprocess.run([sys.executable, "-c", FIRST_DISCOVERY], env=env, capture_output=True, text=True,
+                             timeout=60)
+    finally:
+        stop_all(processes)
+    assert ran.returncode == 0, ran.stderr
+    seen = json.loads(ran.stdout)
+    assert "ghost" in seen["nodes"] and "talker" in seen["nodes"]  # the ghost's message did come
+    assert seen["waited"] >= 2.0

@@ -150,13 +150,26 @@ class FakeGraph:
     def signature(self):
         return round(self.clock.now, 2) if self.clock.now < self.settles_at else "settled"
 
-    def _complete(self):
+    def _complete(self, told):
         return True
 
     def _local_peers_discovered(self, domain: int) -> bool | None:
         if self.peers_at == "uncountable":
             return None
         return self.peers_at is not None and self.clock.now >= self.peers_at
+
+
+class FakeReader:
+    """Stands in for roc.ros.discovery_info.DiscoveryInfoReader: nothing told, nothing to wait for."""
+
+    def __init__(self, node) -> None:
+        pass
+
+    def take(self) -> dict:
+        return {}
+
+    def close(self) -> None:
+        pass
 
 
 @pytest.mark.parametrize("settles_at, peers_at, period, ends_at", [
@@ -177,8 +190,10 @@ def test_discovery_ends_when_this_hosts_participants_are_heard_and_the_graph_is_
 
     clock = FakeClock()
     monkeypatch.setattr(graph_module, "time", clock)
+    monkeypatch.setattr(graph_module, "DiscoveryInfoReader", FakeReader)
     monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
     fake = FakeGraph(clock, settles_at, peers_at)
+    fake.node = None
     fake.context = type("Context", (), {"get_domain_id": lambda self: 0})()
     graph_module.Graph.wait_for_discovery(fake, period)
     assert clock.now == pytest.approx(ends_at, abs=graph_module.POLL_SECONDS + 1e-9)
@@ -190,8 +205,10 @@ def test_beyond_this_host_discovery_waits_longer_for_quiet(monkeypatch):
 
     clock = FakeClock()
     monkeypatch.setattr(graph_module, "time", clock)
+    monkeypatch.setattr(graph_module, "DiscoveryInfoReader", FakeReader)
     monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "SUBNET")
     fake = FakeGraph(clock, 0.0, 0.0)
+    fake.node = None
     fake.context = type("Context", (), {"get_domain_id": lambda self: 0})()
     graph_module.Graph.wait_for_discovery(fake, 3.5)
     assert clock.now == pytest.approx(graph_module.QUIET_SECONDS, abs=graph_module.POLL_SECONDS + 1e-9)

@@ -1,0 +1,104 @@
+"""What every ROS participant says its nodes hold, read from ``ros_discovery_info``.
+
+Each participant publishes there (rmw_dds_common's ParticipantEntitiesInfo: reliable, transient local,
+again whenever they change) its nodes and the GIDs of their readers and writers. rmw's graph cache
+takes the node names from it but shows an endpoint only once the endpoint's own announcement (SEDP)
+has arrived, which may come later: under load one came 0.65 s after the rest of its participant's.
+So a fresh participant holds the whole of another participant once it has that participant's latest
+message and has discovered every node and endpoint the message lists
+(roc.ros.discovery.incomplete_participants).
+
+rcl cannot subscribe to that topic: it makes every name absolute, ``/ros_discovery_info``, which no
+writer has. rmw takes a DDS name as given when ROS's conventions are avoided, so the reader is made
+with ``rmw_create_subscription`` through ctypes, on the rmw node under an rclpy node.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+
+from rclpy.serialization import deserialize_message
+from rmw_dds_common.msg import ParticipantEntitiesInfo
+
+from roc.errors import RocError
+from roc.ros.discovery import DISCOVERY_TOPIC, Told
+from roc.ros.native import (
+    RET_OK,
+    MessageInfo,
+    QosProfile,
+    SerializedMessage,
+    discovery_qos,
+    free_serialized_message,
+    rmw_library,
+    rmw_node,
+    serialized_message,
+    type_support,
+)
+
+# Every participant's message shares the topic's one instance, so the history must hold all that come
+# between two takes (a take every poll of the discovery wait)
+DEPTH = 1000
+
+
+class _Options(ctypes.Structure):  # rmw_subscription_options_t
+    _fields_ = [("rmw_specific_subscription_payload", ctypes.c_void_p), ("ignore_local_publications", ctypes.c_bool),
+                ("require_unique_network_flow_endpoints", ctypes.c_int), ("content_filter_options", ctypes.c_void_p)]
+
+
+@functools.cache
+def _rmw() -> ctypes.CDLL:
+    rmw = rmw_library()
+    rmw.rmw_create_subscription.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_char_p,
+                                            ctypes.POINTER(QosProfile), ctypes.POINTER(_Options)]
+    rmw.rmw_create_subscription.restype = ctypes.c_void_p
+    rmw.rmw_take_serialized_message_with_info.argtypes = [
+        ctypes.c_void_p, ctypes.POINTER(SerializedMessage), ctypes.POINTER(ctypes.c_bool),
+        ctypes.POINTER(MessageInfo), ctypes.c_void_p]
+    rmw.rmw_destroy_subscription.argtypes = [ctypes.c_void_p, ctypes.c_void_p]
+    return rmw
+
+
+def told(message: ParticipantEntitiesInfo) -> Told:
+    """The nodes (namespace, name) and endpoint GIDs a participant's message lists."""
+    nodes = message.node_entities_info_seq
+    return Told(nodes=frozenset((node.node_namespace, node.node_name) for node in nodes),
+                endpoints=frozenset(bytes(gid.data) for node in nodes
+                                    for gid in (*node.reader_gid_seq, *node.writer_gid_seq)))
+
+
+class DiscoveryInfoReader:
+    """A reader of ``ros_discovery_info`` on ``node``'s participant (other participants' messages only);
+    ``take`` gives each writer's latest, ``close`` destroys it (before the node)."""
+
+    def __init__(self, node) -> None:
+        self._rmw = _rmw()
+        self._node = node
+        self._rmw_node = rmw_node(node)
+        qos = discovery_qos(DEPTH)
+        options = _Options(ignore_local_publications=True)
+        self._subscription = self._rmw.rmw_create_subscription(
+            self._rmw_node, type_support(ParticipantEntitiesInfo), DISCOVERY_TOPIC.encode(), ctypes.byref(qos),
+            ctypes.byref(options))
+        if not self._subscription:
+            raise RocError(f"the middleware cannot subscribe to {DISCOVERY_TOPIC}")
+        self._buffer = serialized_message()
+        self._latest: dict[bytes, Told] = {}
+
+    def take(self) -> dict[bytes, Told]:
+        """What each writer (by GID) told last, with every message that came since the last take."""
+        taken, info = ctypes.c_bool(), MessageInfo()
+        while True:
+            result = self._rmw.rmw_take_serialized_message_with_info(
+                self._subscription, ctypes.byref(self._buffer), ctypes.byref(taken), ctypes.byref(info), None)
+            if result != RET_OK:
+                raise RocError(f"taking from {DISCOVERY_TOPIC} failed ({result})")
+            if not taken.value:
+                return dict(self._latest)
+            message = deserialize_message(self._buffer.data(), ParticipantEntitiesInfo)
+            self._latest[bytes(info.publisher_gid.data)] = told(message)
+
+    def close(self) -> None:
+        with self._node.handle:
+            self._rmw.rmw_destroy_subscription(self._rmw_node, self._subscription)
+        free_serialized_message(self._buffer)

@@ -1,0 +1,55 @@
+"""A process that tells, on ros_discovery_info, a node whose endpoint nothing announces: node /ghost of
+a made-up participant, with one writer GID no participant has. Its message comes from a writer of its
+own, made through rmw as roc's reader is (rcl cannot name the topic). Prints "ready" once the message
+is published, then sleeps until killed."""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import time
+
+import rclpy
+from rclpy.node import Node
+from rclpy.serialization import serialize_message
+from rmw_dds_common.msg import Gid, NodeEntitiesInfo, ParticipantEntitiesInfo
+
+from roc.ros.discovery import DISCOVERY_TOPIC
+from roc.ros.native import QosProfile, SerializedMessage, discovery_qos, rmw_library, rmw_node, type_support
+
+GHOST_PARTICIPANT = bytes.fromhex("010f" "7f01" "abcd" "0000" "01000000" "000001c1")
+GHOST_WRITER = bytes.fromhex("010f" "7f01" "abcd" "0000" "01000000" "00000103")
+
+
+class PublisherOptions(ctypes.Structure):  # rmw_publisher_options_t
+    _fields_ = [("rmw_specific_publisher_payload", ctypes.c_void_p),
+                ("require_unique_network_flow_endpoints", ctypes.c_int)]
+
+
+def main() -> None:
+    rclpy.init()
+    node = Node(f"ghost_teller_{os.getpid()}")
+    rmw = rmw_library()
+    rmw.rmw_create_publisher.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_char_p,
+                                         ctypes.POINTER(QosProfile), ctypes.POINTER(PublisherOptions)]
+    rmw.rmw_create_publisher.restype = ctypes.c_void_p
+    rmw.rmw_publish_serialized_message.argtypes = [ctypes.c_void_p, ctypes.POINTER(SerializedMessage),
+                                                   ctypes.c_void_p]
+    publisher = rmw.rmw_create_publisher(rmw_node(node), type_support(ParticipantEntitiesInfo),
+                                         DISCOVERY_TOPIC.encode(), ctypes.byref(discovery_qos(1)),
+                                         ctypes.byref(PublisherOptions()))
+    assert publisher, "rmw_create_publisher failed"
+    ghost = NodeEntitiesInfo(node_namespace="/", node_name="ghost",
+                             writer_gid_seq=[Gid(data=list(GHOST_WRITER))])
+    message = ParticipantEntitiesInfo(gid=Gid(data=list(GHOST_PARTICIPANT)), node_entities_info_seq=[ghost])
+    data = serialize_message(message)
+    buffer = (ctypes.c_uint8 * len(data)).from_buffer_copy(data)
+    serialized = SerializedMessage(buffer=buffer, buffer_length=len(data), buffer_capacity=len(data))
+    assert rmw.rmw_publish_serialized_message(publisher, ctypes.byref(serialized), None) == 0
+    print("ready", flush=True)
+    while True:
+        time.sleep(1)
+
+
+if __name__ == "__main__":
+    main()
