@@ -59,7 +59,7 @@ def _rmw() -> ctypes.CDLL:
     return rmw
 
 
-def told(message: ParticipantEntitiesInfo) -> Told:
+def _told(message: ParticipantEntitiesInfo) -> Told:
     """The nodes (namespace, name) and endpoint GIDs a participant's message lists."""
     nodes = message.node_entities_info_seq
     return Told(nodes=frozenset((node.node_namespace, node.node_name) for node in nodes),
@@ -96,7 +96,7 @@ class DiscoveryInfoReader:
             if not taken.value:
                 return dict(self._latest)
             message = deserialize_message(self._buffer.data(), ParticipantEntitiesInfo)
-            self._latest[bytes(info.publisher_gid.data)] = told(message)
+            self._latest[bytes(info.publisher_gid.data)] = _told(message)
 
     def close(self) -> None:
         with self._node.handle:

@@ -12,6 +12,7 @@ import time
 import rclpy
 from rclpy.node import Node
 from rclpy.serialization import serialize_message
+from rclpy.signals import SignalHandlerOptions
 from rmw_dds_common.msg import Gid, NodeEntitiesInfo, ParticipantEntitiesInfo
 
 from roc.ros.discovery import DISCOVERY_TOPIC
@@ -27,7 +28,7 @@ class PublisherOptions(ctypes.Structure):  # rmw_publisher_options_t
 
 
 def main() -> None:
-    rclpy.init()
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)  # SIGTERM ends the process
     node = Node(f"ghost_teller_{os.getpid()}")
     rmw = rmw_library()
     rmw.rmw_create_publisher.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_char_p,
