@@ -193,6 +193,13 @@ def test_a_first_query_hears_processes_that_announce_themselves_once_a_minute(tm
         stop_all(processes)
 
 
+def _printed_by(script: str, env: dict[str, str]) -> dict:
+    """The JSON ``script`` prints, run by a Python process of its own in ``env``."""
+    ran = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=60)
+    assert ran.returncode == 0, ran.stderr
+    return json.loads(ran.stdout)
+
+
 # In a process of its own: what roc's ros_discovery_info reader tells of the talker's participant, beside
 # what the rmw graph cache shows of the talker's endpoints once it has discovered them all
 TOLD_AND_DISCOVERED = """
@@ -229,12 +236,9 @@ def test_a_participant_tells_on_ros_discovery_info_each_endpoint_the_graph_disco
     processes = start_nodes([{"name": "talker", "publishers": [{"topic": "chatter", "type": "std_msgs/msg/String"}],
                               "services": [{"name": "reset", "type": "std_srvs/srv/Trigger"}]}], env)
     try:
-        ran = subprocess.run([sys.executable, "-c", TOLD_AND_DISCOVERED], env=env, capture_output=True, text=True,
-                             timeout=60)
+        seen = _printed_by(TOLD_AND_DISCOVERED, env)
     finally:
         stop_all(processes)
-    assert ran.returncode == 0, ran.stderr
-    seen = json.loads(ran.stdout)
     [told] = seen["told"]
     assert told["nodes"] == [["/", "talker"]]
     # rosout, parameter events, chatter, and the requests and replies of reset and the parameter services
@@ -270,11 +274,8 @@ def test_a_first_query_waits_for_an_endpoint_a_participant_told_but_never_announ
     processes.append(teller)
     try:
         assert read_line(teller) == "ready\n"
-        ran = subprocess.run([sys.executable, "-c", FIRST_DISCOVERY], env=env, capture_output=True, text=True,
-                             timeout=60)
+        seen = _printed_by(FIRST_DISCOVERY, env)
     finally:
         stop_all(processes)
-    assert ran.returncode == 0, ran.stderr
-    seen = json.loads(ran.stdout)
     assert "ghost" in seen["nodes"] and "talker" in seen["nodes"]  # the ghost's message did come
     assert seen["waited"] >= 1.0
