@@ -228,6 +228,7 @@ print(json.dumps({"told": [{"nodes": sorted(t.nodes), "endpoints": sorted(gid.he
 """
 
 
+@pytest.mark.slow
 @pytest.mark.distro
 def test_a_participant_tells_on_ros_discovery_info_each_endpoint_the_graph_discovers_for_its_node(tmp_path: Path) -> None:
     """rmw's graph cache, reading the same messages, is the oracle: the GIDs roc's reader is told for the
@@ -261,6 +262,7 @@ print(json.dumps({"waited": waited, "nodes": nodes}))
 """
 
 
+@pytest.mark.slow
 @pytest.mark.distro
 def test_a_first_query_waits_for_an_endpoint_a_participant_told_but_never_announced(tmp_path: Path) -> None:
     """A late endpoint, made lasting: node /ghost is told with a writer no participant announces. Every
