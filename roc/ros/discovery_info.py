@@ -28,7 +28,6 @@ from roc.ros.native import (
     MessageInfo,
     QosProfile,
     SerializedMessage,
-    discovery_qos,
     free_serialized_message,
     rmw_library,
     rmw_node,
@@ -39,11 +38,19 @@ from roc.ros.native import (
 # Every participant's message shares the topic's one instance, so the history must hold all that come
 # between two takes (a take every poll of the discovery wait)
 DEPTH = 1000
+KEEP_LAST, RELIABLE, TRANSIENT_LOCAL = 1, 1, 1  # rmw_qos_*_policy_e values
 
 
 class _Options(ctypes.Structure):  # rmw_subscription_options_t
     _fields_ = [("rmw_specific_subscription_payload", ctypes.c_void_p), ("ignore_local_publications", ctypes.c_bool),
                 ("require_unique_network_flow_endpoints", ctypes.c_int), ("content_filter_options", ctypes.c_void_p)]
+
+
+def discovery_qos(depth: int) -> QosProfile:
+    """rmw_dds_common's profile of ``ros_discovery_info`` (reliable, transient local, its DDS name
+    outside ROS's conventions), keeping ``depth`` messages."""
+    return QosProfile(history=KEEP_LAST, depth=depth, reliability=RELIABLE, durability=TRANSIENT_LOCAL,
+                      avoid_ros_namespace_conventions=True)
 
 
 @functools.cache

@@ -16,9 +16,8 @@ import functools
 from typing import Any
 
 from roc.errors import RocError
-from roc.ros.native import Allocator, type_support
+from roc.ros.native import RET_OK, Allocator, type_support
 
-RCL_RET_OK = 0
 RCL_RET_UNSUPPORTED = 3
 _SPARE = 256  # bytes after each struct roc declares: room for fields a newer rcl adds at the end
 
@@ -74,13 +73,13 @@ def _refusal(node, msg_type: type, topic: str, expression: str, parameters: list
     rcl, rcutils = _libraries()
     options = rcl.rcl_subscription_get_default_options()
     if rcl.rcl_subscription_options_set_content_filter_options(
-            expression.encode(), len(parameters), _arguments(parameters), ctypes.byref(options)) != RCL_RET_OK:
+            expression.encode(), len(parameters), _arguments(parameters), ctypes.byref(options)) != RET_OK:
         return _error(rcutils)
     probe = ctypes.c_void_p()  # rcl_subscription_t: one pointer, zero-initialized
     with node.handle:
         result = rcl.rcl_subscription_init(ctypes.byref(probe), node.handle.pointer, type_support(msg_type),
                                            topic.encode(), ctypes.byref(options))
-        if result != RCL_RET_OK:
+        if result != RET_OK:
             refused = _error(rcutils)
             rcl.rcl_subscription_options_fini(ctypes.byref(options))
             rcutils.rcutils_reset_error()
@@ -115,7 +114,7 @@ def set_filter(node, subscription, msg_type: type, topic: str, expression: str, 
         if result == RCL_RET_UNSUPPORTED:
             _error(rcutils)
             return f"{middleware} does not support content filters"
-        if result != RCL_RET_OK:  # the throwaway subscription took the same filter: not expected
+        if result != RET_OK:  # the throwaway subscription took the same filter: not expected
             raise RocError(f"the middleware failed to set the content filter on {topic}: {_error(rcutils)}")
         if not rcl.rcl_subscription_is_cft_enabled(pointer):
             return f"{middleware} does not filter content"

@@ -16,7 +16,6 @@ from roc.ros.protocol import middleware
 
 RET_OK = 0  # RCL_RET_OK, RMW_RET_OK
 GID_SIZE = 16  # RMW_GID_STORAGE_SIZE (Jazzy, Kilted)
-KEEP_LAST, RELIABLE, TRANSIENT_LOCAL = 1, 1, 1  # rmw_qos_*_policy_e values
 
 
 class Allocator(ctypes.Structure):  # rcutils_allocator_t
@@ -52,13 +51,6 @@ class QosProfile(ctypes.Structure):  # rmw_qos_profile_t
                 ("durability", ctypes.c_int), ("deadline", Duration), ("lifespan", Duration),
                 ("liveliness", ctypes.c_int), ("liveliness_lease_duration", Duration),
                 ("avoid_ros_namespace_conventions", ctypes.c_bool)]
-
-
-def discovery_qos(depth: int) -> QosProfile:
-    """rmw_dds_common's profile of ``ros_discovery_info`` (reliable, transient local, its DDS name
-    outside ROS's conventions), keeping ``depth`` messages."""
-    return QosProfile(history=KEEP_LAST, depth=depth, reliability=RELIABLE, durability=TRANSIENT_LOCAL,
-                      avoid_ros_namespace_conventions=True)
 
 
 @functools.cache

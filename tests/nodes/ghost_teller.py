@@ -16,7 +16,8 @@ from rclpy.signals import SignalHandlerOptions
 from rmw_dds_common.msg import Gid, NodeEntitiesInfo, ParticipantEntitiesInfo
 
 from roc.ros.discovery import DISCOVERY_TOPIC
-from roc.ros.native import QosProfile, SerializedMessage, discovery_qos, rmw_library, rmw_node, type_support
+from roc.ros.discovery_info import discovery_qos
+from roc.ros.native import QosProfile, SerializedMessage, rmw_library, rmw_node, type_support
 
 GHOST_PARTICIPANT = bytes.fromhex("010f" "7f01" "abcd" "0000" "01000000" "000001c1")
 GHOST_WRITER = bytes.fromhex("010f" "7f01" "abcd" "0000" "01000000" "00000103")
