@@ -1,5 +1,6 @@
 """The network side of ``roc doctor``, ``roc doctor hello`` and ``roc multicast``: the interfaces and
-their flags, and UDP multicast datagrams sent and received (ros2 multicast's group and port)."""
+their flags, UDP multicast datagrams sent and received (ros2 multicast's group and port), and how large
+a UDP socket's input buffer may grow."""
 
 from __future__ import annotations
 
@@ -8,11 +9,13 @@ import os
 import socket
 import struct
 import time
+from pathlib import Path
 from typing import Any
 
 import psutil
 
 from roc.doctor.findings import Finding
+from roc.ros.discovery import INPUT_BUFFER_BYTES
 
 CATEGORY = "network"
 DEFAULT_GROUP = "225.0.0.1"
@@ -20,6 +23,7 @@ DEFAULT_PORT = 49150
 SIOCGIFFLAGS = 0x8913  # Linux's ioctl for an interface's flags
 FLAG_BITS = {"UP": 0, "BROADCAST": 1, "LOOPBACK": 3, "POINTOPOINT": 4, "RUNNING": 6, "MULTICAST": 12}
 SELF_TEST_SECONDS = 1.0
+RMEM_MAX = Path("/proc/sys/net/core/rmem_max")  # Linux's bound on a socket's input buffer
 
 
 def interface_flags(name: str) -> set[str]:
@@ -107,6 +111,22 @@ def multicast_self_test(interface: str | None = None) -> str | None:
     return f"a datagram sent to {DEFAULT_GROUP} did not come back within {SELF_TEST_SECONDS:g} s"
 
 
+def socket_buffer_check(rmem_max: Path = RMEM_MAX) -> Finding | None:
+    """Whether a participant's discovery socket may grow to what roc's ask for
+    (roc.ros.discovery.enlarge_input_buffers); None where the bound cannot be read (not Linux)."""
+    try:
+        bound = int(rmem_max.read_text())
+    except (OSError, ValueError):
+        return None
+    if bound >= INPUT_BUFFER_BYTES:
+        return Finding(CATEGORY, "socket buffers", "ok", f"input sockets may grow to {bound // 1024} KiB")
+    return Finding(CATEGORY, "socket buffers", "info",
+                   f"net.core.rmem_max is {bound // 1024} KiB: a burst of discovery data (many endpoints "
+                   "announced at once) can overflow a participant's input socket and be heard only at "
+                   "the next heartbeat, up to 1 s later",
+                   f"sudo sysctl -w net.core.rmem_max={INPUT_BUFFER_BYTES} (ROS 2's DDS tuning guide)")
+
+
 def checks(discovery_range: str) -> list[Finding]:
     """Interfaces (loopback, others, multicast) and a multicast round trip; what only matters for
     discovery beyond this host is a warning or error only when the discovery range is SUBNET."""
@@ -140,6 +160,9 @@ def checks(discovery_range: str) -> list[Finding]:
                                 "check the firewall (UDP, 224.0.0.0/4) and that a multicast route exists "
                                 "(ip route get 239.255.0.1); `roc multicast send/receive` tests two hosts"
                                 if subnet else ""))
+    buffers = socket_buffer_check()
+    if buffers is not None:
+        findings.append(buffers)
     return findings
 
 

@@ -17,7 +17,8 @@ roc.ros.discovery_info).
 
 A fresh participant's first announcement goes out before Fast DDS listens, so it would hear some of
 them only at their next periodic announcement: it asks them to announce themselves again
-(``ask_local_participants_to_announce``, roc.ros.spdp).
+(``ask_local_participants_to_announce``, roc.ros.spdp), with input buffers large enough for all their
+answers at once (``enlarge_input_buffers``).
 
 Participants on other hosts (a discovery range beyond this host) cannot be counted: the caller waits
 for the graph to go quiet for them. This module reads /proc and rclpy endpoint infos and sends UDP
@@ -44,6 +45,7 @@ MAX_PARTICIPANT_ID = 119  # the highest id whose ports stay within the domain's 
 DISCOVERY_TOPIC = "ros_discovery_info"  # a DDS name, outside ROS's conventions (no rt/ prefix)
 FAST_DDS_VENDOR = b"\x01\x0f"
 UDP_TABLES = (Path("/proc/net/udp"), Path("/proc/net/udp6"))
+INPUT_BUFFER_BYTES = 4 * 1024 * 1024  # what a participant's discovery socket asks for (enlarge_input_buffers)
 
 
 def is_metatraffic_port(port: int, domain_id: int) -> bool:
@@ -59,17 +61,22 @@ def process_bits(prefix: bytes) -> int | None:
     return int.from_bytes(prefix[4:6], "little")
 
 
-def own_socket_inodes() -> set[str]:
-    """The inodes of this process's sockets (its own participants' ports are not peers)."""
-    inodes = set()
+def _own_sockets() -> dict[int, str]:
+    """This process's sockets: file descriptor and inode."""
+    sockets = {}
     for fd in os.listdir("/proc/self/fd"):
         try:
             target = os.readlink(f"/proc/self/fd/{fd}")
         except OSError:  # closed meanwhile
             continue
         if target.startswith("socket:["):
-            inodes.add(target[len("socket:["):-1])
-    return inodes
+            sockets[int(fd)] = target[len("socket:["):-1]
+    return sockets
+
+
+def own_socket_inodes() -> set[str]:
+    """The inodes of this process's sockets (its own participants' ports are not peers)."""
+    return set(_own_sockets().values())
 
 
 def metatraffic_sockets(domain_id: int, tables: tuple[Path, ...] = UDP_TABLES) -> list[tuple[str | None, int, bool]]:
@@ -119,6 +126,39 @@ def ask_local_participants_to_announce(domain_id: int, tables: tuple[Path, ...] 
                 sender.sendto(message, peer)
                 asked += 1
             except OSError:  # gone meanwhile, or a full buffer: that one is heard at its next announcement
+                continue
+    return asked
+
+
+def enlarge_input_buffers(domain_id: int, size: int = INPUT_BUFFER_BYTES) -> int:
+    """Ask for ``size`` bytes of input buffer on this process's metatraffic unicast sockets in
+    ``domain_id`` where they have less (Linux grants at most net.core.rmem_max); returns how many were
+    asked. Why: a fresh participant asks every process of this host at once (above), so all of them send
+    it their endpoints' announcements at the same moment, each as its own datagram: with the demo graph's
+    three processes more than the system's default buffer (Linux: 208 KiB) holds. A datagram lost there
+    is heard only when its writer's next heartbeat brings it again, up to 1 s later. This is done from
+    outside Fast DDS because rmw replaces Fast DDS's transports on the LOCALHOST range, where a
+    profile's listenSocketBufferSize is not applied."""
+    asked = 0
+    for fd in _own_sockets():
+        try:
+            copy = os.dup(fd)
+        except OSError:  # closed meanwhile
+            continue
+        try:
+            sock = socket.socket(fileno=copy)
+        except OSError:  # no longer a socket
+            os.close(copy)
+            continue
+        with sock:
+            try:
+                port = sock.getsockname()[1] if sock.family in (socket.AF_INET, socket.AF_INET6) else 0
+                if (sock.type != socket.SOCK_DGRAM or not is_metatraffic_port(port, domain_id)
+                        or sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) >= size):
+                    continue
+                sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, size)
+                asked += 1
+            except OSError:
                 continue
     return asked
 

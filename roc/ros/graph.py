@@ -33,6 +33,7 @@ from roc.ros.discovery import (
     Told,
     ask_local_participants_to_announce,
     discovered_local_peers,
+    enlarge_input_buffers,
     incomplete_participants,
     local_participant_count,
 )
@@ -178,6 +179,7 @@ class Graph:
         for publisher in list(self.node.publishers):
             if publisher.topic_name == "/parameter_events":
                 self.node.destroy_publisher(publisher)
+        enlarge_input_buffers(self.context.get_domain_id())
         ask_local_participants_to_announce(self.context.get_domain_id())
         self.events = events
         self.executor = EventsExecutor(context=self.context) if events else SingleThreadedExecutor(context=self.context)

@@ -14,6 +14,8 @@ import pytest
 from helpers.build import BIN, DISTRO, REQUIREMENTS, ros_domain_id, ros_env
 
 from roc import distribution
+from roc.doctor.network import RMEM_MAX
+from roc.ros.discovery import INPUT_BUFFER_BYTES
 
 
 @pytest.mark.distro
@@ -36,10 +38,20 @@ def test_doctor_reports_the_distribution(tmp_path: Path) -> None:
 
 
 PROFILE_PROBE = """
-import json, os
+import json, os, socket
+from roc.ros.discovery import is_metatraffic_port
 from roc.ros.graph import PROFILE_VARIABLES, Graph
 graph = Graph()
-print(json.dumps({name: os.environ.get(name) for name in PROFILE_VARIABLES}))
+buffers = []
+for fd in map(int, os.listdir("/proc/self/fd")):
+    try:
+        sock = socket.socket(fileno=os.dup(fd))
+    except OSError:  # not a socket
+        continue
+    with sock:
+        if sock.type == socket.SOCK_DGRAM and is_metatraffic_port(sock.getsockname()[1], int(os.environ["ROS_DOMAIN_ID"])):
+            buffers.append(sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF))
+print(json.dumps({"variables": {name: os.environ.get(name) for name in PROFILE_VARIABLES}, "buffers": buffers}))
 graph.close()
 """
 
@@ -47,16 +59,21 @@ graph.close()
 @pytest.mark.distro
 def test_roc_s_participants_load_its_fast_dds_profile_without_a_complaint(tmp_path: Path) -> None:
     """Fast DDS 3 (Kilted) rejects a profile file with Fast DDS 2's element names (Jazzy's), and Kilted's rmw
-    warns about Fast DDS 2's variable: either one prints on stderr and loses roc's settings."""
+    warns about Fast DDS 2's variable: either one prints on stderr and loses roc's settings (its
+    announcement period and input socket buffers)."""
     done = subprocess.run([sys.executable, "-c", PROFILE_PROBE], env=ros_env(ROS_DOMAIN_ID=ros_domain_id(50),
                           ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST"), capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and done.stderr == "", done.stderr
     chosen = distribution.current().profiles_variable
-    variables = json.loads(done.stdout)
+    found = json.loads(done.stdout)
+    variables = found["variables"]
     profile = Path(variables.pop(chosen))
     assert set(variables.values()) == {None}
     assert profile.name == ("fastdds_participant.xml" if DISTRO == "jazzy" else "fastdds3_participant.xml")
     assert "<leaseAnnouncement><sec>0</sec><nanosec>500000000</nanosec></leaseAnnouncement>" in profile.read_text()
+    # roc enlarged its discovery socket (roc.ros.discovery.enlarge_input_buffers; Linux doubles what it grants)
+    granted = min(INPUT_BUFFER_BYTES, int(RMEM_MAX.read_text()))
+    assert found["buffers"] == [2 * granted], found["buffers"]
 
 
 @pytest.mark.distro

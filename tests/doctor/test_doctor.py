@@ -20,7 +20,7 @@ import pytest
 from helpers.build import BIN, stop_process
 from helpers.graph import graph_env, read_line, roc, start_nodes, stop_all, stop_daemon, wait_for
 
-from roc.doctor import environment
+from roc.doctor import environment, network
 from roc.doctor.findings import Finding, summary
 from roc.ros.protocol import discovery_range
 
@@ -41,6 +41,17 @@ def test_domain_check(value: str, level: str) -> None:
 def test_discovery_check(env: dict[str, str], levels: list[str]) -> None:
     assert [f.level for f in environment.discovery(env)] == levels
     assert discovery_range({"ROS_LOCALHOST_ONLY": "1"}) == "LOCALHOST"
+
+
+@pytest.mark.parametrize("rmem_max, level", [("212992\n", "info"), ("4194304\n", "ok"), ("8388608\n", "ok")])
+def test_socket_buffer_check_tells_when_input_sockets_cannot_grow_to_what_roc_asks(
+        tmp_path: Path, rmem_max: str, level: str) -> None:
+    bound = tmp_path / "rmem_max"
+    bound.write_text(rmem_max)
+    found = network.socket_buffer_check(bound)
+    assert found is not None and found.level == level
+    assert ("sysctl -w net.core.rmem_max=4194304" in found.fix) == (level == "info")
+    assert network.socket_buffer_check(tmp_path / "absent") is None
 
 
 def _prefix(root: Path, *packages: str) -> Path:
@@ -126,7 +137,7 @@ def test_doctor_finds_what_is_wrong_with_a_graph(doctor_env):
                 "RELIABLE\n") in text.stdout
         assert "  warning  topics: Publisher without subscriber detected on /chatter.\n" in text.stdout
         assert "  warning  topics: Subscriber without publisher detected on /cmd.\n" in text.stdout
-        assert text.stdout.endswith("/10 check(s) failed\n\nFailed modules: graph\n")
+        assert text.stdout.endswith("/11 check(s) failed\n\nFailed modules: graph\n")
         data = json.loads(roc("doctor", "--format", "json", env=env).stdout)
         assert data["failed_categories"] == ["graph"] and data["errors"] == 2
         assert {(f["check"], f["level"]) for f in data["findings"] if f["category"] == "graph"} == {
@@ -145,7 +156,7 @@ def test_doctor_passes_a_healthy_graph_and_reports(doctor_env):
         healthy = roc("doctor", env=env)
         assert healthy.returncode == 0, healthy.stdout
         assert "graph:\n  ok       node names: 2 node(s), each named once\n" in healthy.stdout
-        assert healthy.stdout.endswith("\nAll 10 checks passed\n")
+        assert healthy.stdout.endswith("\nAll 11 checks passed\n")
         assert roc("wtf", env=env).returncode == 0  # ros2's alias
         report = roc("doctor", "--report", env=env)
         assert report.returncode == 0

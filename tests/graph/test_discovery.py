@@ -17,9 +17,11 @@ from helpers.graph import NODE_SCRIPT, graph_env, read_line, roc, start_nodes, s
 
 from roc import distribution
 from roc.ros.discovery import (
+    INPUT_BUFFER_BYTES,
     Told,
     ask_local_participants_to_announce,
     discovered_local_peers,
+    enlarge_input_buffers,
     incomplete_participants,
     local_participant_count,
     metatraffic_sockets,
@@ -133,6 +135,25 @@ def test_the_other_processes_participants_are_asked_to_announce_themselves_to_ou
     finally:
         ours.close()
         theirs.close()
+
+
+def test_this_process_s_discovery_sockets_are_enlarged_and_no_other_socket() -> None:
+    """Domain 201, above the tests' domains: one socket at a participant's discovery port, one beside it."""
+    [discovery] = _bound_at_free_participant_ports(201, 1)
+    other = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    try:
+        other.bind(("127.0.0.1", 0))
+        for sock in (discovery, other):
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 65536)
+        small = other.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
+        assert enlarge_input_buffers(201) == 1
+        granted = min(INPUT_BUFFER_BYTES, int(Path("/proc/sys/net/core/rmem_max").read_text()))
+        assert discovery.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) == 2 * granted  # Linux doubles it
+        assert other.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) == small
+        assert enlarge_input_buffers(201) == (0 if 2 * granted >= INPUT_BUFFER_BYTES else 1)  # not when as large
+    finally:
+        discovery.close()
+        other.close()
 
 
 def test_a_fast_dds_participant_asked_announces_itself_to_the_stand_in_s_port(tmp_path: Path) -> None:
