@@ -82,7 +82,8 @@ class Daemon:
         self.ready.set()
 
     def _client(self, conn: socket.socket) -> None:
-        with conn, conn.makefile("r", encoding="utf-8") as reader:
+        with conn, conn.makefile("r", encoding="utf-8") as reader, contextlib.suppress(OSError):
+            # OSError: the client went away (a broken pipe; or reset, when it closed with answers unread)
             for line in reader:
                 self.last_request = time.monotonic()
                 try:
@@ -92,13 +93,10 @@ class Daemon:
                     request, request_id = {}, None
                 # Closed as soon as the client is gone, so a stream's endpoint goes with it.
                 with contextlib.closing(self._answer(request)) as responses:
-                    try:
-                        for response in responses:
-                            response["id"] = request_id
-                            conn.sendall((json.dumps(response) + "\n").encode())
-                            self.last_request = time.monotonic()
-                    except OSError:
-                        return
+                    for response in responses:
+                        response["id"] = request_id
+                        conn.sendall((json.dumps(response) + "\n").encode())
+                        self.last_request = time.monotonic()
                 if request.get("method") == "shutdown":
                     return
 

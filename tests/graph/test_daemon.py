@@ -152,6 +152,24 @@ def test_bad_request_gets_an_error_line(talker):
     assert second["final"] and "error" in second
 
 
+def test_a_client_gone_with_answers_unread_leaves_no_traceback_in_the_daemon_s_log(talker):
+    """Closing a Unix socket with data unread resets the connection: the daemon's next read fails."""
+    import socket
+
+    env = talker
+    roc("daemon", "start", env=env)
+    path = Path(status(env)["socket"])
+    before = path.with_suffix(".log").stat().st_size  # the log is appended to, run after run
+    sock = socket.socket(socket.AF_UNIX)
+    sock.connect(str(path))
+    sock.sendall(b'{"id": 1, "method": "hello"}\n')
+    time.sleep(0.3)  # the answer waits, unread
+    sock.close()
+    assert roc("topic", "list", env=env).returncode == 0  # the daemon still answers
+    log = path.with_suffix(".log").read_bytes()[before:].decode()
+    assert "Traceback" not in log, log
+
+
 @pytest.mark.xdist_group("busy_or_timing")
 def test_no_daemon_is_complete(tmp_path):
     """Five processes, ten daemon-less runs: every node every time (ros2 misses some in most runs)."""
