@@ -3,8 +3,9 @@ first query answers as soon as it has seen everything instead of after a fixed w
 
 Two facts make the local part exact:
 - every RTPS participant binds the metatraffic unicast UDP port its domain and participant id give
-  (RTPS 9.6.1.1: 7400 + 250 * domain + 10 + 2 * id), so ``/proc/net/udp`` tells how many participants
-  this host has in a domain, whether or not they have been heard yet;
+  (RTPS 9.6.1.1: 7400 + 250 * domain + 10 + 2 * id) and the user-data port above it, so
+  ``/proc/net/udp`` tells how many participants this host has in a domain, whether or not they have
+  been heard yet;
 - every ROS participant has one writer on ``ros_discovery_info`` (rmw_dds_common), and Fast DDS's GUID
   prefix carries the writer's host id (bytes 2-3) and process id (bytes 4-5, little-endian), so the
   writers seen tell which of those participants have been discovered.
@@ -40,6 +41,7 @@ PORT_BASE = 7400
 DOMAIN_GAIN = 250
 PARTICIPANT_GAIN = 2
 METATRAFFIC_UNICAST_OFFSET = 10
+USER_PORT_OFFSET = 1  # a participant's user-data unicast port, above its metatraffic one (RTPS 9.6.1.1)
 UNKNOWN_NODE = "_NODE_NAME_UNKNOWN_"  # rmw_dds_common's name for the node of an endpoint not told yet
 MAX_PARTICIPANT_ID = 119  # the highest id whose ports stay within the domain's 250
 DISCOVERY_TOPIC = "ros_discovery_info"  # a DDS name, outside ROS's conventions (no rt/ prefix)
@@ -81,18 +83,23 @@ def own_socket_inodes() -> set[str]:
 
 def metatraffic_sockets(domain_id: int, tables: tuple[Path, ...] = UDP_TABLES) -> list[tuple[str | None, int, bool]]:
     """The metatraffic unicast sockets bound on this host (this network namespace) in ``domain_id``:
-    (IPv4 address, None for IPv6; port; whether this process owns it). Raises OSError when the UDP
-    tables cannot be read (not Linux)."""
+    (IPv4 address, None for IPv6; port; whether this process owns it). A participant binds the port
+    above too (its user data's), which tells it from any process's socket on an ephemeral port that
+    happens to be one of the domain's (domains 102 to 214 lie among Linux's ephemeral ports). Raises
+    OSError when the UDP tables cannot be read (not Linux)."""
     own = own_socket_inodes()
-    sockets = []
+    bound = []
     for table in tables:
         for line in table.read_text().splitlines()[1:]:
             fields = line.split()
             address, port_hex = fields[1].rsplit(":", 1)
-            port = int(port_hex, 16)
-            if is_metatraffic_port(port, domain_id):
-                ipv4 = ".".join(str(b) for b in reversed(bytes.fromhex(address))) if len(address) == 8 else None
-                sockets.append((ipv4, port, fields[9] in own))
+            bound.append((address, int(port_hex, 16), fields[9]))
+    ports = {port for _, port, _ in bound}
+    sockets = []
+    for address, port, inode in bound:
+        if is_metatraffic_port(port, domain_id) and port + USER_PORT_OFFSET in ports:
+            ipv4 = ".".join(str(b) for b in reversed(bytes.fromhex(address))) if len(address) == 8 else None
+            sockets.append((ipv4, port, inode in own))
     return sockets
 
 

@@ -39,13 +39,16 @@ def _udp_line(port: int, inode: str, address: str = "00000000") -> str:
     return f"  1: {address}:{port:04X} 00000000:0000 07 00000000:00000000 00:00000000 00000000     0        0 {inode} 2 0 0\n"
 
 
-def test_this_hosts_participants_are_counted_by_their_bound_discovery_ports(tmp_path: Path) -> None:
+def test_this_hosts_participants_are_counted_by_their_bound_discovery_ports_not_ephemeral_ones(
+        tmp_path: Path) -> None:
     own = next(iter(own_socket_inodes() or {"none"}))
     table = tmp_path / "udp"
-    # domain 3: participants 0 and 2 of other processes, participant 1 this process's own; 7411 and
-    # 8161 are another domain's and a user traffic port, 7000 anything else
-    table.write_text(UDP_HEADER + _udp_line(8160, "11") + _udp_line(8164, "12") + _udp_line(8162, own)
-                     + _udp_line(8161, "13") + _udp_line(7410, "14") + _udp_line(7000, "15"))
+    # domain 3: participants 0 and 2 of other processes, participant 1 this process's own, each with its
+    # user-data port above; 8166 some process's ephemeral socket (no port above it); 7410 another
+    # domain's participant, 7000 anything else
+    table.write_text(UDP_HEADER + "".join(_udp_line(port, inode) for port, inode in (
+        (8160, "11"), (8161, "11"), (8164, "12"), (8165, "12"), (8162, own), (8163, own), (8166, "13"),
+        (7410, "14"), (7411, "14"), (7000, "15"))))
     assert local_participant_count(3, (table,)) == 2
     assert local_participant_count(0, (table,)) == 1
     assert local_participant_count(3, (tmp_path / "missing",)) is None
@@ -121,8 +124,8 @@ def test_the_other_processes_participants_are_asked_to_announce_themselves_to_ou
         own_inode = next(iter(own_socket_inodes()))
         table = tmp_path / "udp"
         loopback = "0100007F"  # 127.0.0.1 as the kernel writes it
-        table.write_text(UDP_HEADER + _udp_line(ours.getsockname()[1], own_inode, loopback)
-                         + _udp_line(theirs.getsockname()[1], "99", loopback))
+        table.write_text(UDP_HEADER + "".join(_udp_line(port + offset, inode, loopback) for port, inode in (
+            (ours.getsockname()[1], own_inode), (theirs.getsockname()[1], "99")) for offset in (0, 1)))
         assert metatraffic_sockets(200, (table,)) == [("127.0.0.1", ours.getsockname()[1], True),
                                                       ("127.0.0.1", theirs.getsockname()[1], False)]
         assert ask_local_participants_to_announce(200, (table,)) == 1
