@@ -98,13 +98,15 @@ def goal(graph, params: dict[str, Any]) -> Events:
         if not client.wait_for_server(timeout_sec=0.1):
             yield {"event": "waiting"}
             yield from _wait(lambda: client.wait_for_server(timeout_sec=HEARTBEAT_SECONDS))
-        handle = yield from _sent(graph, partial(client.send_goal_async, request, goal_uuid=goal_id))
+        sent = yield from _requested(graph, partial(client.send_goal_async, request, goal_uuid=goal_id))
+        yield from _wait(lambda: _done(sent))
+        handle = sent.result()
         if not handle.accepted:
             handle = None
             yield {"event": "rejected"}
             return
         yield {"event": "accepted", "goal_id": bytes(handle.goal_id.uuid).hex()}
-        result = yield from _sent(graph, handle.get_result_async, wait=False)
+        result = yield from _requested(graph, handle.get_result_async)
         beat = time.monotonic() + HEARTBEAT_SECONDS
         while True:
             finished = result.done()  # then every feedback the server sent before the result is taken below
@@ -156,17 +158,12 @@ class FeedbackReader:
         self._subscription.destroy()
 
 
-def _sent(graph, send: Callable[[], Any], wait: bool = True) -> Generator[dict[str, Any], None, Any]:
+def _requested(graph, send: Callable[[], Any]) -> Generator[dict[str, Any], None, Any]:
     """Heartbeats while ``send()`` (an action client's request) runs on the Graph's spinning thread
-    (Graph.on_spinner: why), and, with ``wait``, while its response comes; returns the response, or
-    the request's future without ``wait``."""
+    (Graph.on_spinner: why); returns the request's future."""
     sending = graph.on_spinner(send)
     yield from _wait(lambda: _done(sending))
-    future = sending.result()
-    if not wait:
-        return future
-    yield from _wait(lambda: _done(future))
-    return future.result()
+    return sending.result()
 
 
 def _done(future) -> bool:
