@@ -6,7 +6,6 @@ the stream closes; a goal still running then is canceled."""
 from __future__ import annotations
 
 import base64
-import threading
 import time
 import uuid
 from collections.abc import Callable, Generator, Iterator
@@ -75,6 +74,7 @@ def call(graph, params: dict[str, Any]) -> Events:
 
 FEEDBACK_DEPTH = 100  # feedback messages kept between two takes, POLL_SECONDS apart
 POLL_SECONDS = 0.005
+CLEANUP_SECONDS = 2.0  # a canceled goal's response, and the client's end, waited for at most
 GOAL_STATUS = {0: "UNKNOWN", 1: "ACCEPTED", 2: "EXECUTING", 3: "CANCELING", 4: "SUCCEEDED", 5: "CANCELED",
                6: "ABORTED"}
 
@@ -92,13 +92,15 @@ def goal(graph, params: dict[str, Any]) -> Events:
     goal_id = UUID(uuid=list(uuid.uuid4().bytes))
     feedback = FeedbackReader(graph.node, cls, params["action"], bytes(goal_id.uuid)) \
         if params.get("feedback") else None
-    client = ActionClient(graph.node, cls, params["action"])
+    # made and destroyed on the spinning thread: Kilted's rclpy (9.1) adds an action client to the
+    # node's waitables before it is whole, and an executor that collects it then fails
+    client = yield from _on_spinner(graph, partial(ActionClient, graph.node, cls, params["action"]))
     handle = None
     try:
         if not client.wait_for_server(timeout_sec=0.1):
             yield {"event": "waiting"}
             yield from _wait(lambda: client.wait_for_server(timeout_sec=HEARTBEAT_SECONDS))
-        sent = yield from _requested(graph, partial(client.send_goal_async, request, goal_uuid=goal_id))
+        sent = yield from _on_spinner(graph, partial(client.send_goal_async, request, goal_uuid=goal_id))
         yield from _wait(lambda: _done(sent))
         handle = sent.result()
         if not handle.accepted:
@@ -106,7 +108,7 @@ def goal(graph, params: dict[str, Any]) -> Events:
             yield {"event": "rejected"}
             return
         yield {"event": "accepted", "goal_id": bytes(handle.goal_id.uuid).hex()}
-        result = yield from _requested(graph, handle.get_result_async)
+        result = yield from _on_spinner(graph, handle.get_result_async)
         beat = time.monotonic() + HEARTBEAT_SECONDS
         while True:
             finished = result.done()  # then every feedback the server sent before the result is taken below
@@ -124,10 +126,10 @@ def goal(graph, params: dict[str, Any]) -> Events:
         yield {"event": "result", **_answer(outcome.result, plain), "status": status}
     finally:
         if handle is not None:  # the client went away first: do not leave the goal running
-            canceled = threading.Event()
-            graph.on_spinner(lambda: handle.cancel_goal_async().add_done_callback(lambda _: canceled.set()))
-            canceled.wait(2.0)
-        client.destroy()
+            canceling = graph.on_spinner(handle.cancel_goal_async)
+            if _done(canceling, CLEANUP_SECONDS):
+                _done(canceling.result(), CLEANUP_SECONDS)
+        _done(graph.on_spinner(client.destroy), CLEANUP_SECONDS)
         if feedback is not None:
             feedback.destroy()
 
@@ -158,18 +160,18 @@ class FeedbackReader:
         self._subscription.destroy()
 
 
-def _requested(graph, send: Callable[[], Any]) -> Generator[dict[str, Any], None, Any]:
-    """Heartbeats while ``send()`` (an action client's request) runs on the Graph's spinning thread
-    (Graph.on_spinner: why); returns the request's future."""
-    sending = graph.on_spinner(send)
-    yield from _wait(lambda: _done(sending))
-    return sending.result()
+def _on_spinner(graph, function: Callable[[], Any]) -> Generator[dict[str, Any], None, Any]:
+    """Heartbeats while ``function()`` (an action client's request, or making the client) runs on the
+    Graph's spinning thread (Graph.on_spinner: why); returns what it returned."""
+    running = graph.on_spinner(function)
+    yield from _wait(lambda: _done(running))
+    return running.result()
 
 
-def _done(future) -> bool:
-    """Whether ``future`` (completed by the Graph's executor thread) is done, waiting up to a
-    heartbeat for it."""
-    deadline = time.monotonic() + HEARTBEAT_SECONDS
+def _done(future, seconds: float = HEARTBEAT_SECONDS) -> bool:
+    """Whether ``future`` (completed by the Graph's executor thread) is done, waiting up to
+    ``seconds`` for it."""
+    deadline = time.monotonic() + seconds
     while not future.done() and time.monotonic() < deadline:
         time.sleep(0.005)
     return future.done()

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import logging
 import os
 import signal
 import socket
@@ -136,6 +137,8 @@ class Daemon:
 
 def main() -> None:
     path, listener_fd = Path(sys.argv[1]), int(sys.argv[2])
+    # stderr is the daemon's log (roc.ros.client.spawn_daemon)
+    logging.basicConfig(level=logging.WARNING, format="%(asctime)s %(name)s: %(message)s")
     daemon = Daemon(path)
     signal.signal(signal.SIGTERM, lambda *_: daemon.stopping.set())
     signal.signal(signal.SIGINT, signal.SIG_IGN)

@@ -9,6 +9,7 @@ daemon and for daemon-less runs alike.
 
 from __future__ import annotations
 
+import logging
 import os
 import threading
 import time
@@ -66,6 +67,7 @@ LOCAL_QUIET_SECONDS = 0.1
 ANNOUNCEMENT_SECONDS = 3.0  # Fast DDS's default period of a participant's announcements
 POLL_SECONDS = 0.05
 SERVICE_TIMEOUT = 5.0
+LOG = logging.getLogger(__name__)  # the daemon writes it to its log; a library adds no handler of its own
 SPIN_SLICE = 0.1  # seconds an executor waits before it looks whether the graph is closing
 
 
@@ -190,11 +192,18 @@ class Graph:
         self._spinner.start()
 
     def _spin(self) -> None:
-        try:
-            while not self._stopping.is_set():
+        """Spin until closed. A callback that raises is logged once per kind of failure and spinning goes
+        on: one failure must not stop every later request of a daemon that serves for hours."""
+        logged: set[str] = set()
+        while not self._stopping.is_set():
+            try:
                 self.executor.spin_once(timeout_sec=SPIN_SLICE)
-        except Exception:  # noqa: BLE001 - the context was shut down under it
-            pass
+            except Exception as error:  # noqa: BLE001 - see the docstring
+                if self._stopping.is_set() or not self.context.ok():
+                    return  # the context was shut down under it
+                if repr(error) not in logged:
+                    logged.add(repr(error))
+                    LOG.warning("a callback failed on the graph's spinning thread; spinning on", exc_info=True)
 
     def close(self) -> None:
         """Stop spinning, then shut down. The EventsExecutor deadlocks if its context is shut down while
@@ -215,7 +224,8 @@ class Graph:
         """Run ``function()`` on the thread that spins the node, between two callbacks; the future's
         result is what it returns. Why: rclpy 7's action client records a request only after sending
         it, so a response handled on the spinning thread in between is dropped as unexpected and the
-        request never completes (a goal hung about once in 150 on a busy machine)."""
+        request never completes (a goal hung about once in 150 on a busy machine); and rclpy 9 adds an
+        action client to the node's waitables before the client is whole."""
         return self.executor.create_task(function)
 
     # -- discovery ------------------------------------------------------------------------------------

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from helpers.graph import graph_env, start_nodes, stop_all
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.distro]
 
 SLOT = 60
 GOALS = 60
@@ -20,10 +20,11 @@ GOALS = 60
 FAST_SERVER = {"name": "fast_server", "actions": [{"name": "fast_fibonacci", "step_seconds": 0.0}]}
 
 SCRIPT = r'''
-import json, sys, time
+import json, logging, sys, time
 from roc.ros.calls import goal
 from roc.ros.graph import Graph
 
+logging.basicConfig()  # a callback that failed on the graph's spinning thread is told on stderr
 graph = Graph()
 graph.wait_for_discovery()
 outcomes = []
@@ -46,7 +47,8 @@ graph.close()
 def test_every_goal_gets_all_its_feedback_before_its_result_and_none_hangs(tmp_path: Path) -> None:
     """rclpy 7's action client could drop a response that came while the goal or result request was
     being recorded (the goal then never ended), and handled a result that came with the last feedback
-    before that feedback: 5 of 150 goals lost it on a busy machine."""
+    before that feedback: 5 of 150 goals lost it on a busy machine. rclpy 9's (Kilted's) failed in the
+    executor that collected it half made, about once in 100 goals."""
     env = graph_env(SLOT, tmp_path)
     server = start_nodes([[FAST_SERVER]], env)
     try:
@@ -54,7 +56,7 @@ def test_every_goal_gets_all_its_feedback_before_its_result_and_none_hangs(tmp_p
                               timeout=300)
     finally:
         stop_all(server)
-    assert done.returncode == 0, done.stderr
+    assert done.returncode == 0 and done.stderr == "", done.stderr
     expected = ["accepted", "feedback", "feedback", "result", {"sequence": [0, 1, 1]}, {"sequence": [0, 1, 1, 2]},
                 {"sequence": [0, 1, 1, 2]}]
     outcomes = json.loads(done.stdout)

@@ -35,15 +35,15 @@ def test_a_base_too_high_or_not_a_number_is_refused(monkeypatch):
 
 
 def test_no_test_hard_codes_a_domain():
-    """Every test that sets ROS_DOMAIN_ID takes it from a slot (ros_domain_id or graph_env), and no two
-    test files share a slot."""
+    """Every test that sets ROS_DOMAIN_ID takes it from a slot (ros_domain_id or graph_env, given as a number
+    or a file's SLOT constant), and no two test files share a slot."""
     owners: dict[int, set[str]] = {}
     for path in TESTS.rglob("test_*.py"):
         text = path.read_text()
         assert not re.search(r"ROS_DOMAIN_ID[\"']?\s*[:=]\s*[\"']?\d", text.replace('"ROS_DOMAIN_ID", "7"', "")
                              .replace('"ROS_DOMAIN_ID": "3"', "")), path.name
-        for slot in re.findall(r"(?:ros_domain_id|graph_env)\((\d+)", text):
-            owners.setdefault(int(slot), set()).add(path.name)
+        for called, constant in re.findall(r"(?:ros_domain_id|graph_env)\((\d+)|^SLOT = (\d+)", text, re.MULTILINE):
+            owners.setdefault(int(called or constant), set()).add(path.name)
     shared = {slot: files for slot, files in owners.items() if len(files) > 1}
     assert not shared, f"domain slots used by several test files: {shared}"
 
