@@ -28,6 +28,7 @@ datagrams; it never imports rclpy itself (``roc tui`` finds each node's process 
 
 from __future__ import annotations
 
+import contextlib
 import os
 import socket
 from collections.abc import Mapping
@@ -139,35 +140,54 @@ def ask_local_participants_to_announce(domain_id: int, tables: tuple[Path, ...] 
 
 def enlarge_input_buffers(domain_id: int, size: int = INPUT_BUFFER_BYTES) -> int:
     """Ask for ``size`` bytes of input buffer on this process's metatraffic unicast sockets in
-    ``domain_id`` where they have less (Linux grants at most net.core.rmem_max); returns how many were
-    asked. Why: a fresh participant asks every process of this host at once (above), so all of them send
-    it their endpoints' announcements at the same moment, each as its own datagram: with the demo graph's
-    three processes more than the system's default buffer (Linux: 208 KiB) holds. A datagram lost there
-    is heard only when its writer's next heartbeat brings it again, up to 1 s later. This is done from
-    outside Fast DDS because rmw replaces Fast DDS's transports on the LOCALHOST range, where a
-    profile's listenSocketBufferSize is not applied."""
+    ``domain_id`` (told from a sender's ephemeral socket as in metatraffic_sockets) where they have less
+    (Linux grants at most net.core.rmem_max); returns how many were asked. Why: a fresh participant asks
+    every process of this host at once (above), so all of them send it their endpoints' announcements at
+    the same moment, each as its own datagram: with the demo graph's three processes more than the
+    system's default buffer (Linux: 208 KiB) holds. A datagram lost there is heard only when its
+    writer's next heartbeat brings it again, up to 1 s later. This is done from outside Fast DDS because
+    rmw replaces Fast DDS's transports on the LOCALHOST range, where a profile's listenSocketBufferSize
+    is not applied."""
     asked = 0
-    for fd in _own_sockets():
-        try:
-            copy = os.dup(fd)
-        except OSError:  # closed meanwhile
-            continue
-        try:
-            sock = socket.socket(fileno=copy)
-        except OSError:  # no longer a socket
-            os.close(copy)
-            continue
-        with sock:
-            try:
-                port = sock.getsockname()[1] if sock.family in (socket.AF_INET, socket.AF_INET6) else 0
-                if (sock.type != socket.SOCK_DGRAM or not is_metatraffic_port(port, domain_id)
-                        or sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) >= size):
-                    continue
-                sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, size)
-                asked += 1
-            except OSError:
+    with contextlib.ExitStack() as opened:
+        by_port: dict[int, list[socket.socket]] = {}
+        for fd in _own_sockets():
+            sock = _datagram_socket(fd)
+            if sock is not None:
+                opened.enter_context(sock)
+                by_port.setdefault(sock.getsockname()[1], []).append(sock)
+        for port, sockets in by_port.items():
+            if not is_metatraffic_port(port, domain_id) or port + USER_PORT_OFFSET not in by_port:
                 continue
+            for sock in sockets:
+                try:
+                    if sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) < size:
+                        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, size)
+                        asked += 1
+                except OSError:
+                    continue
     return asked
+
+
+def _datagram_socket(fd: int) -> socket.socket | None:
+    """A copy of descriptor ``fd`` as a socket when it is a bound IP datagram socket, else None."""
+    try:
+        copy = os.dup(fd)
+    except OSError:  # closed meanwhile
+        return None
+    try:
+        sock = socket.socket(fileno=copy)
+    except OSError:  # no longer a socket
+        os.close(copy)
+        return None
+    try:
+        if sock.type == socket.SOCK_DGRAM and sock.family in (socket.AF_INET, socket.AF_INET6) \
+                and sock.getsockname()[1]:
+            return sock
+    except OSError:
+        pass
+    sock.close()
+    return None
 
 
 def _reachable(address: str) -> str:

@@ -42,15 +42,19 @@ import json, os, socket
 from roc.ros.discovery import is_metatraffic_port
 from roc.ros.graph import PROFILE_VARIABLES, Graph
 graph = Graph()
-buffers = []
+bound = {}
 for fd in map(int, os.listdir("/proc/self/fd")):
     try:
         sock = socket.socket(fileno=os.dup(fd))
     except OSError:  # not a socket
         continue
     with sock:
-        if sock.type == socket.SOCK_DGRAM and is_metatraffic_port(sock.getsockname()[1], int(os.environ["ROS_DOMAIN_ID"])):
-            buffers.append(sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF))
+        if sock.type == socket.SOCK_DGRAM:
+            bound[sock.getsockname()[1]] = sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
+# a participant's discovery port has its user-data port above it; Fast DDS's senders are on ephemeral
+# ports, which in the tests' domains may be one of the domain's discovery ports
+buffers = [size for port, size in bound.items()
+           if is_metatraffic_port(port, int(os.environ["ROS_DOMAIN_ID"])) and port + 1 in bound]
 print(json.dumps({"variables": {name: os.environ.get(name) for name in PROFILE_VARIABLES}, "buffers": buffers}))
 graph.close()
 """

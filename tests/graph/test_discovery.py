@@ -141,22 +141,27 @@ def test_the_other_processes_participants_are_asked_to_announce_themselves_to_ou
 
 
 def test_this_process_s_discovery_sockets_are_enlarged_and_no_other_socket() -> None:
-    """Domain 201, above the tests' domains: one socket at a participant's discovery port, one beside it."""
-    [discovery] = _bound_at_free_participant_ports(201, 1)
+    """Domain 201, above the tests' domains: a participant's discovery socket with its user-data socket
+    above it; a sender's socket that happens to be at another discovery port (no user-data port above
+    it, as Fast DDS's own senders on ephemeral ports); and one on no discovery port."""
+    discovery, sender = _bound_at_free_participant_ports(201, 2)
+    user_data = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     other = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     try:
+        user_data.bind(("127.0.0.1", discovery.getsockname()[1] + 1))
         other.bind(("127.0.0.1", 0))
-        for sock in (discovery, other):
+        for sock in (discovery, sender, user_data, other):
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 65536)
         small = other.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
         assert enlarge_input_buffers(201) == 1
         granted = min(INPUT_BUFFER_BYTES, int(Path("/proc/sys/net/core/rmem_max").read_text()))
         assert discovery.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) == 2 * granted  # Linux doubles it
-        assert other.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) == small
+        assert [sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) for sock in (sender, user_data, other)] \
+            == [small] * 3
         assert enlarge_input_buffers(201) == (0 if 2 * granted >= INPUT_BUFFER_BYTES else 1)  # not when as large
     finally:
-        discovery.close()
-        other.close()
+        for sock in (discovery, sender, user_data, other):
+            sock.close()
 
 
 def test_a_fast_dds_participant_asked_announces_itself_to_the_stand_in_s_port(tmp_path: Path) -> None:
