@@ -5,6 +5,7 @@
   ignored signal stays ignored in every child, a handled one is reset to its default.
 - Tests skipped because an oracle is missing (tests/helpers/oracles.py) are summed up at the end of the run,
   one line per reason, so that a checkout without ``../shared`` says what it did not test.
+- The suite's own process writes byte-code (see below); the processes it starts follow the environment.
 - The whole suite runs on Jazzy (.venv). On another distribution (``bash scripts/test.sh --distro
   kilted``: .venv-kilted) only the distribution suite runs, the tests marked ``distro``: each area end to
   end; the others are distribution-independent and run once, on Jazzy. ROC_TEST_UNMARKED=1 runs them too.
@@ -12,6 +13,7 @@
 
 import os
 import signal
+import sys
 from collections import Counter
 
 import pytest
@@ -23,6 +25,11 @@ FULL_SUITE_DISTRO = "jazzy"
 DISTRO = distribution.current({}).name  # the venv's (tests/helpers/build.py: DISTRO)
 
 share_compiles()
+
+# pytest keeps the test modules it rewrote (for its assert messages) only where byte-code may be written:
+# with PYTHONDONTWRITEBYTECODE set machine-wide, each worker rewrote each changed test module on every run
+# (a second or more of the quick loop). The processes the tests start still see the variable.
+sys.dont_write_bytecode = False
 
 if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)

@@ -35,6 +35,7 @@ except SystemExit:
 """
 
 
+@pytest.mark.slow  # ROS participants of its own (the quick loop stays under 45 s)
 @pytest.mark.parametrize("graph, python_exit", [("closed", False), ("open", True)])
 def test_the_process_ends_as_python_would_and_skips_the_teardown_once_every_graph_is_closed(
         tmp_path: Path, graph: str, python_exit: bool) -> None:

@@ -29,6 +29,7 @@ def test_the_distribution_is_read_from_the_venvs_rclpy() -> None:
 
 
 @pytest.mark.distro
+@pytest.mark.slow  # roc doctor's participants (the quick loop stays under 45 s)
 def test_doctor_reports_the_distribution(tmp_path: Path) -> None:
     done = subprocess.run([str(BIN / "roc"), "doctor", "--no-daemon", "--spin-time", "0.5", "--format", "json"],
                           env=ros_env(ROS_DOMAIN_ID=ros_domain_id(50), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
@@ -61,6 +62,7 @@ graph.close()
 
 
 @pytest.mark.distro
+@pytest.mark.slow  # a participant of its own (the quick loop stays under 45 s)
 def test_roc_s_participants_load_its_fast_dds_profile_without_a_complaint(tmp_path: Path) -> None:
     """Fast DDS 3 (Kilted) rejects a profile file with Fast DDS 2's element names (Jazzy's), and Kilted's rmw
     warns about Fast DDS 2's variable: either one prints on stderr and loses roc's settings (its
@@ -81,6 +83,7 @@ def test_roc_s_participants_load_its_fast_dds_profile_without_a_complaint(tmp_pa
 
 
 @pytest.mark.distro
+@pytest.mark.slow  # a fork server of its own (the quick loop stays under 45 s)
 def test_the_fork_server_preloads_every_type_a_node_loads() -> None:
     """roc launch's warm start: rclpy and the type support of every built-in endpoint of a node."""
     probe = ("from roc.launch import forkserver as f; "

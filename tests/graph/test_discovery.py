@@ -164,6 +164,7 @@ def test_this_process_s_discovery_sockets_are_enlarged_and_no_other_socket() -> 
             sock.close()
 
 
+@pytest.mark.slow  # a node of its own (the quick loop stays under 45 s)
 def test_a_fast_dds_participant_asked_announces_itself_to_the_stand_in_s_port(tmp_path: Path) -> None:
     """The real middleware reads the stand-in's announcement and answers with its own at once."""
     env = graph_env(SLOT, tmp_path)

@@ -123,6 +123,7 @@ def test_print_describes_the_launch_file_as_ros2_launch_does(demo) -> None:
     assert "ExecInPkg(pkg='roc_launch_demo', exec='talker')" in ours.stdout
 
 
+@pytest.mark.slow  # it needs the demo package built (the quick loop stays under 45 s)
 def test_a_missing_file_or_package_is_one_line_listing_what_exists(demo, tmp_path: Path) -> None:
     env, _ = demo
     missing = roc("launch", PACKAGE, "demo.lanch.py", env=env)

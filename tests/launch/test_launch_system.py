@@ -11,7 +11,7 @@ import time
 from pathlib import Path
 
 import pytest
-from helpers.graph import roc, stop_daemon
+from helpers.graph import graph_env, roc, stop_daemon
 from helpers.launch import (
     demo_env,
     kill_leftovers,
@@ -153,6 +153,7 @@ def test_warm_start_can_be_turned_off(demo, tmp_path: Path, how: str) -> None:
                            "robot1/listener": ("listener", servers[0])}
 
 
+@pytest.mark.slow  # it needs the demo package built (the quick loop stays under 45 s)
 def test_explain_says_what_each_process_waits_for(demo, tmp_path: Path) -> None:
     env, prefix = demo
     (tmp_path / "roc.toml").write_text(SYSTEM)
@@ -252,8 +253,9 @@ min-rate = 3
      '[[launch.x.process]]\npackage = "a"\nexecutable = "c"\nafter = ["process b"]\n',
      "roc.toml: the processes of [launch.x] wait for each other in a circle"),
 ])
-def test_a_bad_system_is_one_line_naming_file_line_and_key(demo, tmp_path: Path, text: str, error: str) -> None:
-    env, _ = demo
+def test_a_bad_system_is_one_line_naming_file_line_and_key(tmp_path: Path, text: str, error: str) -> None:
+    """Told before anything is looked up: no package needs to be installed."""
+    env = graph_env(31, tmp_path / "runtime")
     (tmp_path / "roc.toml").write_text(text)
     result = roc("-C", str(tmp_path), "launch", "x", "--explain", env=env)
     assert result.returncode == 2

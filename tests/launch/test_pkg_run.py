@@ -15,6 +15,7 @@ from helpers.graph import install_oracle, roc, ros2, stop_daemon
 from helpers.launch import demo_env, kill_leftovers, wait_for_nodes
 
 PACKAGE = "roc_launch_demo"
+pytestmark = pytest.mark.xdist_group("pkg_run")  # one worker: the demo package built once for its tests
 
 
 @pytest.fixture(scope="module")

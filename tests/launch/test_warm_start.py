@@ -178,6 +178,7 @@ def _gone(pid: int) -> bool:
         return True
 
 
+@pytest.mark.slow  # a server of its own: about half a second of CPU
 def test_a_server_that_dies_takes_its_children_with_it(env, tmp_path: Path) -> None:
     process, client = _own_server(env)
     script = _script(tmp_path, "sleeper.py", SLEEPER)
@@ -248,6 +249,7 @@ def test_a_venvs_python_and_python3_share_a_server(tmp_path: Path) -> None:
         assert _server_key(os.path.realpath(sys.executable), {}) != _server_key(sys.executable, {})
 
 
+@pytest.mark.slow  # a server of its own: about half a second of CPU
 def test_a_server_starts_for_the_second_process_that_can_use_it(env, tmp_path: Path) -> None:
     script = _script(tmp_path, "report.py", REPORT)
     warm = WarmStart()
@@ -283,6 +285,7 @@ def test_prepare_starts_servers_for_shared_interpreters_and_respawns(env, tmp_pa
         assert not Path(f"/proc/{pid}").exists()
 
 
+@pytest.mark.slow  # a server of its own: about half a second of CPU
 def test_the_runners_event_loop_forks_what_it_can(env, tmp_path: Path) -> None:
     script = _script(tmp_path, "report.py", REPORT)
     process, channel = start_server(sys.executable, env)
