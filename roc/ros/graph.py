@@ -13,6 +13,7 @@ import logging
 import os
 import threading
 import time
+import traceback
 from collections.abc import Callable, Mapping, MutableMapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -192,17 +193,20 @@ class Graph:
         self._spinner.start()
 
     def _spin(self) -> None:
-        """Spin until closed. A callback that raises is logged once per kind of failure and spinning goes
-        on: one failure must not stop every later request of a daemon that serves for hours."""
-        logged: set[str] = set()
+        """Spin until closed. A callback that raises is logged once per kind of failure (its exception's
+        type and the line that raised it) and spinning goes on: one failure must not stop every later
+        request of a daemon that serves for hours."""
+        logged: set[tuple[str, str, int | None]] = set()
         while not self._stopping.is_set():
             try:
                 self.executor.spin_once(timeout_sec=SPIN_SLICE)
             except Exception as error:  # noqa: BLE001 - see the docstring
                 if self._stopping.is_set() or not self.context.ok():
                     return  # the context was shut down under it
-                if repr(error) not in logged:
-                    logged.add(repr(error))
+                where = traceback.extract_tb(error.__traceback__)[-1]
+                kind = (type(error).__qualname__, where.filename, where.lineno)
+                if kind not in logged:
+                    logged.add(kind)
                     LOG.warning("a callback failed on the graph's spinning thread; spinning on", exc_info=True)
 
     def close(self) -> None:
