@@ -94,9 +94,11 @@ def goal(graph, params: dict[str, Any]) -> Events:
         if params.get("feedback") else None
     # made and destroyed on the spinning thread: Kilted's rclpy (9.1) adds an action client to the
     # node's waitables before it is whole, and an executor that collects it then fails
-    client = yield from _on_spinner(graph, partial(ActionClient, graph.node, cls, params["action"]))
+    creating = graph.on_spinner(partial(ActionClient, graph.node, cls, params["action"]))
     handle = None
     try:
+        yield from _wait(lambda: _done(creating))
+        client = creating.result()
         if not client.wait_for_server(timeout_sec=0.1):
             yield {"event": "waiting"}
             yield from _wait(lambda: client.wait_for_server(timeout_sec=HEARTBEAT_SECONDS))
@@ -129,7 +131,9 @@ def goal(graph, params: dict[str, Any]) -> Events:
             canceling = graph.on_spinner(handle.cancel_goal_async)
             if _done(canceling, CLEANUP_SECONDS):
                 _done(canceling.result(), CLEANUP_SECONDS)
-        _done(graph.on_spinner(client.destroy), CLEANUP_SECONDS)
+        # also when closed while the client was being made: it is made all the same
+        if _done(creating, CLEANUP_SECONDS) and creating.exception() is None:
+            _done(graph.on_spinner(creating.result().destroy), CLEANUP_SECONDS)
         if feedback is not None:
             feedback.destroy()
 
@@ -161,8 +165,8 @@ class FeedbackReader:
 
 
 def _on_spinner(graph, function: Callable[[], Any]) -> Generator[dict[str, Any], None, Any]:
-    """Heartbeats while ``function()`` (an action client's request, or making the client) runs on the
-    Graph's spinning thread (Graph.on_spinner: why); returns what it returned."""
+    """Heartbeats while ``function()`` (an action client's request) runs on the Graph's spinning thread
+    (Graph.on_spinner: why); returns what it returned."""
     running = graph.on_spinner(function)
     yield from _wait(lambda: _done(running))
     return running.result()
