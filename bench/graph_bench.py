@@ -69,10 +69,20 @@ def tool(name: str) -> str:
     return str(BIN / "roc") if name == "roc" else str(ORACLE_VENV / "bin" / "ros2")
 
 
+RUN_BOUND_SECONDS = 60  # a run still going then is stopped and counted as failed, at this time
+
+
 def timed(name: str, args: tuple[str, ...], env: dict[str, str], boot: bool = True) -> tuple[float, str, int]:
+    """Seconds, stdout and exit code of one run of a tool; a run that hangs (`ros2 service list
+    --no-daemon` did once, on the subnet range) is stopped after RUN_BOUND_SECONDS and counts as a
+    failed run of that time."""
     start = time.perf_counter()
-    done = subprocess.run([tool(name), *args], env=tool_env(env, boot), capture_output=True, text=True,
-                          timeout=120)
+    try:
+        done = subprocess.run([tool(name), *args], env=tool_env(env, boot), capture_output=True, text=True,
+                              timeout=RUN_BOUND_SECONDS)
+    except subprocess.TimeoutExpired:
+        print(f"{name} {' '.join(args)}: still running after {RUN_BOUND_SECONDS} s; stopped", file=sys.stderr)
+        return float(RUN_BOUND_SECONDS), "", -1
     return time.perf_counter() - start, done.stdout, done.returncode
 
 
