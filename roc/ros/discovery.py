@@ -31,7 +31,7 @@ from __future__ import annotations
 import contextlib
 import os
 import socket
-from collections.abc import Mapping
+from collections.abc import Container, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -55,6 +55,14 @@ def is_metatraffic_port(port: int, domain_id: int) -> bool:
     """A metatraffic unicast port of a participant of ``domain_id``."""
     offset = port - PORT_BASE - DOMAIN_GAIN * domain_id - METATRAFFIC_UNICAST_OFFSET
     return 0 <= offset <= PARTICIPANT_GAIN * MAX_PARTICIPANT_ID and offset % PARTICIPANT_GAIN == 0
+
+
+def is_participant_port(port: int, domain_id: int, bound: Container[int]) -> bool:
+    """``port`` is a participant's metatraffic unicast port in ``domain_id``, ``bound`` holding the ports
+    bound beside it: a participant binds its user data's port above too, which tells it from any
+    process's socket on an ephemeral port that happens to be one of the domain's (domains 102 to 214 lie
+    among Linux's ephemeral ports)."""
+    return is_metatraffic_port(port, domain_id) and port + USER_PORT_OFFSET in bound
 
 
 def process_bits(prefix: bytes) -> int | None:
@@ -84,10 +92,8 @@ def own_socket_inodes() -> set[str]:
 
 def metatraffic_sockets(domain_id: int, tables: tuple[Path, ...] = UDP_TABLES) -> list[tuple[str | None, int, bool]]:
     """The metatraffic unicast sockets bound on this host (this network namespace) in ``domain_id``:
-    (IPv4 address, None for IPv6; port; whether this process owns it). A participant binds the port
-    above too (its user data's), which tells it from any process's socket on an ephemeral port that
-    happens to be one of the domain's (domains 102 to 214 lie among Linux's ephemeral ports). Raises
-    OSError when the UDP tables cannot be read (not Linux)."""
+    (IPv4 address, None for IPv6; port; whether this process owns it), told as is_participant_port
+    tells. Raises OSError when the UDP tables cannot be read (not Linux)."""
     own = own_socket_inodes()
     bound = []
     for table in tables:
@@ -98,7 +104,7 @@ def metatraffic_sockets(domain_id: int, tables: tuple[Path, ...] = UDP_TABLES) -
     ports = {port for _, port, _ in bound}
     sockets = []
     for address, port, inode in bound:
-        if is_metatraffic_port(port, domain_id) and port + USER_PORT_OFFSET in ports:
+        if is_participant_port(port, domain_id, ports):
             ipv4 = ".".join(str(b) for b in reversed(bytes.fromhex(address))) if len(address) == 8 else None
             sockets.append((ipv4, port, inode in own))
     return sockets
@@ -140,7 +146,7 @@ def ask_local_participants_to_announce(domain_id: int, tables: tuple[Path, ...] 
 
 def enlarge_input_buffers(domain_id: int, size: int = INPUT_BUFFER_BYTES) -> int:
     """Ask for ``size`` bytes of input buffer on this process's metatraffic unicast sockets in
-    ``domain_id`` (told from a sender's ephemeral socket as in metatraffic_sockets) where they have less
+    ``domain_id`` (is_participant_port: not a sender's ephemeral socket) where they have less
     (Linux grants at most net.core.rmem_max); returns how many were asked. Why: a fresh participant asks
     every process of this host at once (above), so all of them send it their endpoints' announcements at
     the same moment, each as its own datagram: with the demo graph's three processes more than the
@@ -157,7 +163,7 @@ def enlarge_input_buffers(domain_id: int, size: int = INPUT_BUFFER_BYTES) -> int
                 opened.enter_context(sock)
                 by_port.setdefault(sock.getsockname()[1], []).append(sock)
         for port, sockets in by_port.items():
-            if not is_metatraffic_port(port, domain_id) or port + USER_PORT_OFFSET not in by_port:
+            if not is_participant_port(port, domain_id, by_port):
                 continue
             for sock in sockets:
                 try:
