@@ -19,7 +19,7 @@ from roc.cli.commands import (
     command_module,
     requested_command,
 )
-from roc.errors import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_USAGE, RocError, UsageError
+from roc.errors import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_USAGE, RocError
 
 
 def _early_value(argv: list[str], option: str) -> str | None:
@@ -59,10 +59,10 @@ def _apply_workspace_configuration(parser: Parser, path: tuple[str, ...], argv: 
 
 
 def _with_help_pointer(error: RocError, path: tuple[str, ...]) -> str:
-    """A usage error points at the help of the command it was given to, unless it already says where
-    to look (as argparse's errors do, see Parser.error)."""
+    """A usage error (one the daemon raised included) points at the help of the command it was given
+    to, unless it already says where to look (as argparse's errors do, see Parser.error)."""
     message = str(error)
-    if isinstance(error, UsageError) and path and "see '" not in message:
+    if error.exit_code == EXIT_USAGE and path and "see '" not in message:
         message += f" (see '{' '.join(('roc', *path))} --help')"
     return message
 

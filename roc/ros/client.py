@@ -28,7 +28,12 @@ START_TIMEOUT = 15.0
 
 
 class DaemonError(RocError):
-    """The daemon answered with an error (its message is for the user)."""
+    """The daemon answered with an error (its message is for the user; its exit code is the one of
+    the error the daemon raised: bad input is a usage error through the daemon too)."""
+
+    def __init__(self, error: dict[str, Any]) -> None:
+        super().__init__(error["message"])
+        self.exit_code = error.get("exit_code", self.exit_code)
 
 
 def daemon_key(env: dict[str, str] | None = None) -> str:
@@ -93,7 +98,7 @@ class Connection:
     def request(self, method: str, params: dict[str, Any] | None = None, timeout: float = REQUEST_TIMEOUT) -> Any:
         final = list(self.stream(method, params, timeout))[-1]
         if "error" in final:
-            raise DaemonError(final["error"]["message"])
+            raise DaemonError(final["error"])
         return final.get("result")
 
     def close(self) -> None:
@@ -312,7 +317,7 @@ def stream(method: str, params: dict[str, Any], *, use_daemon: bool = True, hear
             if error and error.get("kind") == "UnknownTypeError" and not started:
                 break  # a type the daemon's environment lacks (an overlay sourced since it started)
             if error:
-                raise DaemonError(error["message"])
+                raise DaemonError(error)
             if response.get("event") is not None and response["event"] not in skipped:
                 started = True
                 yield response

@@ -89,17 +89,31 @@ class Logical:
     operands: tuple
 
 
-def _tokens(text: str) -> list[tuple[str, str]]:
+def _quoted(text: str) -> str:
+    """Part of a filter for a message: in double quotes, since its strings are in single ones."""
+    return f"'{text}'" if '"' in text else f'"{text}"'
+
+
+def _place(text: str, position: int, found: str) -> str:
+    """Where an error is in expression ``text``: ``found``, at ``position``, and which character that is."""
+    if position >= len(text.rstrip()):
+        return f"the end of {_quoted(text)}"
+    return f"{_quoted(found)} (character {position + 1}) in {_quoted(text)}"
+
+
+def _tokens(text: str) -> list[tuple[str, str, int]]:
+    """(kind, value, the position it starts at) of each token."""
     tokens, position = [], 0
     while position < len(text.rstrip()):
         match = _TOKEN.match(text, position)
         if match is None or match.end() == position:
-            raise ContentFilterError(f"cannot read '{text[position:].strip()}' in '{text}'")
+            rest = text[position:].lstrip()
+            raise ContentFilterError(f"cannot read {_place(text, len(text) - len(rest), rest.split()[0])}")
         kind = match.lastgroup or ""
-        value = match.group(kind)
+        value, start = match.group(kind), match.start(kind)
         if kind == "word" and value.upper() in KEYWORDS:
             kind, value = "keyword", value.upper()
-        tokens.append((kind, value))
+        tokens.append((kind, value, start))
         position = match.end()
     return tokens
 
@@ -112,7 +126,7 @@ def literal(text: str) -> Literal | None:
         return None
     if len(tokens) != 1:
         return None
-    kind, value = tokens[0]
+    kind, value, _ = tokens[0]
     if kind in ("integer", "hex"):
         return Literal(int(value, 0 if kind == "hex" else 10), NUMBER)
     if kind == "float":
@@ -129,13 +143,19 @@ class _Parser:
         self.text, self.tokens, self.at = text, _tokens(text), 0
 
     def peek(self) -> tuple[str, str]:
-        return self.tokens[self.at] if self.at < len(self.tokens) else ("end", "")
+        return self.tokens[self.at][:2] if self.at < len(self.tokens) else ("end", "")
+
+    def place(self) -> str:
+        """Where the next token is, for an error: ``"x" (character 7) in "..."`` or ``the end of "..."``."""
+        if self.at == len(self.tokens):
+            return _place(self.text, len(self.text), "")
+        _, value, position = self.tokens[self.at]
+        return _place(self.text, position, value)
 
     def take(self, kind: str, value: str | None = None) -> str:
         found = self.peek()
         if found[0] != kind or (value is not None and found[1] != value):
-            wanted = value or kind
-            raise ContentFilterError(f"expected {wanted} at '{found[1] or 'the end'}' in '{self.text}'")
+            raise ContentFilterError(f"expected {value or kind} at {self.place()}")
         self.at += 1
         return found[1]
 
@@ -175,8 +195,7 @@ class _Parser:
             return Parameter(int(value[1:]))
         found = literal(value) if kind != "keyword" or value in ("TRUE", "FALSE") else None
         if found is None:
-            raise ContentFilterError(f"expected a field, a value or a parameter at '{value or 'the end'}' "
-                                     f"in '{self.text}'")
+            raise ContentFilterError(f"expected a field, a value or a parameter at {self.place()}")
         self.at += 1
         return found
 
@@ -191,18 +210,18 @@ class _Parser:
             self.take("keyword", "AND")
             high = self.operand()
             if not isinstance(left, Field) or isinstance(low, Field) or isinstance(high, Field):
-                raise ContentFilterError(f"BETWEEN takes a field and two values, in '{self.text}'")
+                raise ContentFilterError(f"BETWEEN takes a field and two values, in {_quoted(self.text)}")
             return Between(left, low, high, negated)
         if negated:
-            raise ContentFilterError(f"expected BETWEEN after NOT in '{self.text}'")
+            raise ContentFilterError(f"expected BETWEEN after NOT at {self.place()}")
         kind, op = self.peek()
         if kind not in ("op", "keyword") or op not in COMPARISONS:
-            raise ContentFilterError(f"expected a comparison (=, <>, <, <=, >, >=, LIKE, MATCH, BETWEEN) at "
-                                     f"'{op or 'the end'}' in '{self.text}'")
+            raise ContentFilterError(f"expected a comparison (=, <>, <, <=, >, >=, LIKE, MATCH, BETWEEN) "
+                                     f"at {self.place()}")
         self.at += 1
         right = self.operand()
         if not isinstance(left, Field) and not isinstance(right, Field):
-            raise ContentFilterError(f"each comparison needs a field, in '{self.text}'")
+            raise ContentFilterError(f"each comparison needs a field, in {_quoted(self.text)}")
         return Comparison(left, "<>" if op == "!=" else op, right)
 
 
@@ -256,7 +275,7 @@ class ContentFilter:
         parser = _Parser(expression)
         self._tree = parser.condition()
         if parser.peek()[0] != "end":
-            raise ContentFilterError(f"unexpected '{parser.peek()[1]}' in '{expression}'")
+            raise ContentFilterError(f"unexpected {parser.place()}")
         if len(parameters or []) > 100:
             raise ContentFilterError("at most 100 parameters (%0 to %99)")
         self._values = [literal(text) or Literal(text, STRING) for text in parameters or []]
@@ -264,7 +283,7 @@ class ContentFilter:
         self.parameters = [text if literal(text) else "'" + text + "'" for text in parameters or []]
         for index in _parameters(self._tree):
             if index >= len(self._values):
-                raise ContentFilterError(f"'{expression}' uses %{index} but {len(self._values)} parameter(s) "
+                raise ContentFilterError(f"{_quoted(expression)} uses %{index} but {len(self._values)} parameter(s) "
                                          "were given (--content-filter-params)")
         if any("'" in value.value for value in self._values if value.kind == STRING):
             raise ContentFilterError("a string parameter may not hold a quote (')")
@@ -283,7 +302,7 @@ class ContentFilter:
                          for side in (node.left, node.right)]
                 text = node.op
                 if node.op in ("LIKE", "MATCH") and kinds != [STRING, STRING]:
-                    raise ContentFilterError(f"{node.op} compares strings, in '{self.expression}'")
+                    raise ContentFilterError(f"{node.op} compares strings, in {_quoted(self.expression)}")
                 if node.op == "MATCH" and not isinstance(node.right, Field):
                     try:
                         _pattern("MATCH", self._value(node.right).value)
@@ -291,7 +310,7 @@ class ContentFilter:
                         raise ContentFilterError(f"MATCH: not a regular expression ({error})") from None
             if len(set(kinds)) != 1:
                 other = next(kind for kind in kinds if kind != kinds[0])
-                raise ContentFilterError(f"{text} compares a {kinds[0]} with a {other}, in '{self.expression}'")
+                raise ContentFilterError(f"{text} compares a {kinds[0]} with a {other}, in {_quoted(self.expression)}")
 
     def accepts(self, message: Any) -> bool:
         return self._evaluate(self._tree, message)

@@ -130,7 +130,8 @@ class Daemon:
                     result = self.graph.handle(method, params)
             yield {"final": True, "result": result}
         except RocError as error:
-            yield {"final": True, "error": {"kind": type(error).__name__, "message": str(error)}}
+            yield {"final": True, "error": {"kind": type(error).__name__, "message": str(error),
+                                            "exit_code": error.exit_code}}
         except Exception as error:  # noqa: BLE001 - the daemon outlives a bad request
             yield {"final": True, "error": {"kind": "internal", "message": f"{type(error).__name__}: {error}"}}
 

@@ -96,7 +96,7 @@ class Feed:
                 if stop():
                     return
                 if "error" in response:
-                    raise DaemonError(response["error"]["message"])
+                    raise DaemonError(response["error"])
                 if response.get("event") is not None:
                     yield response
         finally:

@@ -42,13 +42,17 @@ def test_parameters_are_literals_and_a_bare_word_is_a_string():
 
 
 @pytest.mark.parametrize(("expression", "parameters", "error"), [
-    ("data = ", [], "expected a field, a value or a parameter at 'the end' in 'data = '"),
-    ("data = 3", [], "= compares a string with a number, in 'data = 3'"),
+    ("data = ", [], 'expected a field, a value or a parameter at the end of "data = "'),
+    ("data = 3", [], '= compares a string with a number, in "data = 3"'),
     ("nope = 'x'", [], "'nope': String has no field 'nope' (it has data)"),
-    ("data = %1", ["x"], "'data = %1' uses %1 but 1 parameter(s) were given (--content-filter-params)"),
-    ("data LIKE 3", [], "LIKE compares strings, in 'data LIKE 3'"),
-    ("(data = 'x'", [], "expected ) at 'the end' in '(data = 'x''"),
-    ("'x' = 'y'", [], "each comparison needs a field, in ''x' = 'y''"),
+    ("data = %1", ["x"], '"data = %1" uses %1 but 1 parameter(s) were given (--content-filter-params)'),
+    ("data LIKE 3", [], 'LIKE compares strings, in "data LIKE 3"'),
+    ("(data = 'x'", [], "expected ) at the end of \"(data = 'x'\""),
+    ("'x' = 'y'", [], "each comparison needs a field, in \"'x' = 'y'\""),
+    ("data = 'a b' data", [], "unexpected \"data\" (character 14) in \"data = 'a b' data\""),
+    ("data IS 'x'", [], "expected a comparison (=, <>, <, <=, >, >=, LIKE, MATCH, BETWEEN) at \"IS\" (character 6) "
+                        "in \"data IS 'x'\""),
+    ('data = "x"', [], """cannot read '"x"' (character 8) in 'data = "x"'"""),
 ])
 def test_a_bad_filter_says_what_is_wrong(expression, parameters, error):
     from std_msgs.msg import String
@@ -145,10 +149,18 @@ def test_hz_and_bw_measure_what_passes(numbers):
 
 
 @pytest.mark.slow
-def test_a_field_the_type_lacks_is_one_line(numbers):
+def test_a_field_the_type_lacks_is_a_usage_error_as_a_syntax_error_is(numbers):
+    """The field is checked in the daemon (it knows the topic's type), the syntax before asking it: one
+    exit code and one form of line for both."""
+    help_pointer = " (see 'roc topic echo --help')\n"
     result = roc("topic", "echo", "/numbers", "--content-filter", "number > 3", env=numbers)
-    assert (result.returncode, result.stdout) == (1, "")
-    assert result.stderr == "roc: error: --content-filter: 'number': String has no field 'number' (it has data)\n"
+    assert (result.returncode, result.stdout) == (2, "")
+    assert result.stderr == ("roc: error: --content-filter: 'number': String has no field 'number' (it has data)"
+                             + help_pointer)
+    result = roc("topic", "echo", "/numbers", "--content-filter", "data >", env=numbers)
+    assert (result.returncode, result.stdout) == (2, "")
+    assert result.stderr == ('roc: error: --content-filter: expected a field, a value or a parameter at the end '
+                             'of "data >"' + help_pointer)
 
 
 @pytest.mark.slow
