@@ -15,6 +15,7 @@ from textual.screen import Screen
 from roc.errors import RocError, UsageError
 from roc.tui.feed import Feed
 from roc.tui.graph_screen import GraphScreen
+from roc.tui.keys import MOVES
 from roc.tui.packages import WorkspaceView
 from roc.tui.palette import RocCommands, palette_lines
 from roc.tui.widgets import TextViewer, binding_lines
@@ -185,8 +186,9 @@ class RocApp(App[int]):
         screen = type(self.screen).__name__.removesuffix("Screen")
         lines = binding_lines(f"{screen} screen", self.screen.BINDINGS, self.get_key_display)
         lines += binding_lines("everywhere", self.BINDINGS, self.get_key_display)
-        lines += ["Arrows, Page Up/Down, Home/End move in a list; Enter opens what is under the cursor;",
-                  "Esc goes back (or clears the filter). In an input: Enter accepts, Esc cancels.", "",
+        lines += [f"{keys}: {what}" for keys, what in MOVES]
+        lines += ["Enter opens what is under the cursor; Esc goes back (or clears the filter).",
+                  "In an input: Enter accepts, Esc cancels.", "",
                   "commands (: opens the palette, then type one):", *(f"  {line}" for line in palette_lines())]
         self.push_screen(TextViewer("keys (Esc: back)", "\n".join(lines)))
 

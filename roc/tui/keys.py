@@ -30,6 +30,11 @@ NAMES = {"slash": "/", "question_mark": "?", "colon": ":", "escape": "Esc", "ent
          "right_square_bracket": "]"}
 
 
+# the keys of every list (roc.tui.widgets.ListTable), as the manual and the help say them
+MOVES = (("Up/Down, Page Up/Down, Home/End", "move in a list (Home, End: to its first, its last row)"),
+         ("Left/Right", "scroll a list wider than the screen sideways"))
+
+
 def key_text(key: str) -> str:
     if key in NAMES:
         return f"`{NAMES[key]}`" if len(NAMES[key]) == 1 else NAMES[key]
@@ -55,7 +60,7 @@ def key_table() -> str:
     """The manual's table of keys (Markdown)."""
     lines = ["| screen | key | what it does |", "| --- | --- | --- |"]
     lines += [f"| {screen} | {keys} | {what} |" for screen, keys, what in bindings()]
-    lines.append("| everywhere | arrows, Page Up/Down, Home/End | move in a list |")
+    lines += [f"| everywhere | {keys} | {what} |" for keys, what in MOVES]
     lines.append("| prompts and text | Enter, Esc | accept, cancel (close) |")
     return "\n".join(lines)
 

@@ -52,7 +52,14 @@ MARKS = {"error": "!! ", "warning": "!  ", "": "   "}  # still seen without colo
 class ListTable(DataTable):
     """Rows (roc.tui.model.Row) shown as a table: on each ``show`` only changed cells are redrawn, and
     the cursor stays on the row it was on. ``filter`` keeps the rows whose cells match it. Without
-    colour (NO_COLOR: ANSI mode), the cursor's row is drawn in reverse video."""
+    colour (NO_COLOR: ANSI mode), the cursor's row is drawn in reverse video. Home and End move the
+    cursor to the first and the last row (DataTable's scroll a row cursor's table sideways, so a key
+    that acts on the row under the cursor acted on another than the one the user went to)."""
+
+    BINDINGS = [
+        Binding("home", "scroll_top", "first row", show=False),
+        Binding("end", "scroll_bottom", "last row", show=False),
+    ]
 
     DEFAULT_CSS = """
     ListTable:ansi > .datatable--cursor { text-style: reverse; }

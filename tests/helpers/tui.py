@@ -17,6 +17,7 @@ from pathlib import Path
 
 from helpers.build import NODES, REPO
 from helpers.graph import read_line, start_nodes, stop_all, stop_daemon
+from roc.tui.feed import Feed
 from roc.tui.widgets import ListTable
 
 SIZE = (80, 24)
@@ -116,6 +117,24 @@ def make_workspace(root: Path) -> Path:
         (package / "CMakeLists.txt").write_text(CMAKE.format(name=name, extra=extra))
         (package / "package.xml").write_text(MANIFEST.format(name=name, depends=depends))
     return root
+
+
+class DataFeed(Feed):
+    """The daemon's answers given as data (no daemon, no ROS): ``data`` is the snapshot, ``answers`` the
+    answers to other queries by method; no streams."""
+
+    def __init__(self, snapshot: dict, answers: dict | None = None) -> None:
+        super().__init__()
+        self.data, self.answers = snapshot, answers or {}
+
+    def snapshot(self) -> dict:
+        return self.data
+
+    def query(self, method, params=None):
+        return self.answers[method]
+
+    def stream(self, method, params, stop):
+        return iter(())
 
 
 def text_of(app, selector: str) -> str:

@@ -7,7 +7,7 @@ import asyncio
 from typing import Any
 
 import pytest
-from helpers.tui import SIZE, table, until
+from helpers.tui import SIZE, DataFeed, table, until
 from textual.widgets import TabbedContent
 
 from roc.tui.app import RocApp
@@ -21,20 +21,6 @@ def still_snapshot(topics: int = 3) -> dict[str, Any]:
                        for name in names],
             "services": [{"name": "/talker/get_parameters", "types": ["rcl_interfaces/srv/GetParameters"]}],
             "actions": []}
-
-
-class DataFeed(Feed):
-    """The daemon's answers given as data: a snapshot, no streams."""
-
-    def __init__(self, snapshot: dict[str, Any]) -> None:
-        super().__init__()
-        self.data = snapshot
-
-    def snapshot(self) -> dict[str, Any]:
-        return self.data
-
-    def stream(self, method, params, stop):
-        return iter(())
 
 
 @pytest.mark.slow  # a few seconds (the quick loop stays under 45 s)
