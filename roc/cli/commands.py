@@ -238,7 +238,8 @@ def build_parser(argv: list[str] | None = None) -> Parser:
     wanted = requested_command(argv) if argv is not None else None
     parser = Parser(prog="roc", description="roc: fast, dependable tools for ROS 2 workspaces.")
     parser.add_argument("--version", action="version", version=f"roc {__version__}")
-    parser.add_argument("--debug", action="store_true", help="show Python tracebacks for errors")
+    parser.add_argument("--debug", action="store_true",
+                        help="show Python tracebacks for errors (also after the command: roc doctor --debug)")
     parser.add_argument("-C", dest="directory", metavar="DIR", help="run as if roc was started in DIR")
     leaves: dict[tuple[str, ...], Parser] = {}
     groups: dict[tuple[str, ...], argparse._SubParsersAction] = {
@@ -260,6 +261,9 @@ def build_parser(argv: list[str] | None = None) -> Parser:
         if module is not None:
             if wanted is None or wanted == path:
                 command_module(module).add_arguments(sub)
+                if "--debug" not in sub._option_string_actions:  # roc launch's -d/--debug is ros2 launch's
+                    # roc's own --debug where a user puts it (roc.cli.main reads it), shown once in `roc --help`
+                    sub.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
                 if path[0] == "work" and path[-1] in CONFIGURED_VERBS:
                     sub.add_argument("--profile", metavar="NAME", help="use [profile.NAME] of roc.toml")
             sub.set_defaults(_module=module, _group=None)

@@ -3,6 +3,7 @@ the closest name for a mistyped command or option, and every group's help listin
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import io
 import re
@@ -48,6 +49,16 @@ def test_allow_abbrev_is_off_in_every_parser() -> None:
 
     parser = build_parser()
     assert not parser.allow_abbrev and all(not leaf.allow_abbrev for leaf in parser.leaves.values())
+
+
+def test_every_verb_takes_debug_after_it_too() -> None:
+    """The internal error's hint says "run with --debug": where a user adds it, after the command."""
+    from roc.cli.commands import build_parser
+
+    for path, leaf in build_parser().leaves.items():
+        assert "--debug" in leaf._option_string_actions, path
+        if path != ("launch",):  # whose -d/--debug is ros2 launch's (and turns on roc's too)
+            assert leaf._option_string_actions["--debug"].help == argparse.SUPPRESS, path  # shown in roc --help
 
 
 def cli(*args: str, env: dict[str, str], cwd: Path | None = None) -> subprocess.CompletedProcess:

@@ -89,9 +89,10 @@ def test_bad_arguments_exit_2(arguments: list[str], message: str, tmp_path: Path
     assert len(lines) == 1 and message in lines[0] and "Traceback" not in result.stderr
 
 
-def test_debug_shows_the_traceback(tmp_path: Path) -> None:
+@pytest.mark.parametrize("words", [["--debug", "work", "list"], ["work", "list", "--debug"]])
+def test_debug_before_or_after_the_command_shows_the_traceback(tmp_path: Path, words: list[str]) -> None:
     workspace = copy_fixture("bad_missing_name", tmp_path / "bad_missing_name")
-    result = run_roc("--debug", "work", "list", cwd=workspace)
+    result = run_roc(*words, cwd=workspace)
     assert result.returncode != 0
     assert "Traceback (most recent call last)" in result.stderr
     assert "ManifestError" in result.stderr and "has no <name>" in result.stderr
