@@ -1,6 +1,6 @@
 """The command palette (``:``): every view by name (``nodes``, ``topics``, ``logs [NODE]``, ``plot TOPIC
 FIELD...``, ``image TOPIC``, ``diagnostics``, ``frames``, ``bag PATH``, ``launch``, ``build``, ``publish TOPIC``), and
-any node, topic, service or action of the graph by its name."""
+any node, topic, service or action of the graph by its name (every word typed must be part of it)."""
 
 from __future__ import annotations
 
@@ -8,6 +8,8 @@ from collections.abc import Callable
 from functools import partial
 
 from textual.command import DiscoveryHit, Hit, Hits, Provider
+
+from roc.tui.model import matches
 
 # view -> (what its words after the name are, what it shows); the app's ``open`` takes the same names
 VIEWS = {
@@ -26,6 +28,7 @@ VIEWS = {
     "build": ("", "roc work build of the workspace, shown live"),
 }
 NEEDS_WORDS = {"plot", "image", "publish", "bag"}
+FIRST = 1e9  # the score of a view named with its words: above any of Textual's fuzzy matcher (up to tens)
 
 
 def palette_lines() -> list[str]:
@@ -53,11 +56,15 @@ class RocCommands(Provider):
 
     async def search(self, query: str) -> Hits:
         name, _, words = query.strip().lstrip(":").partition(" ")
+        view = ""
         if name in VIEWS and (words.strip() or name not in NEEDS_WORDS):  # a view with its words: first
-            yield Hit(1.0, f"{name} {words}".strip(), partial(self.app.open, name, words.strip()),  # type: ignore[attr-defined]
+            view = f"{name} {words}".strip()
+            yield Hit(FIRST, view, partial(self.app.open, name, words.strip()),  # type: ignore[attr-defined]
                       help=VIEWS[name][1])
         matcher = self.matcher(query)
         for text, command, help_text in self.commands():
-            score = matcher.match(text)
+            # each word typed must appear in the entry, as the lists' filter asks (roc.tui.model.matches): the
+            # fuzzy matcher alone took any entry holding the letters in order (``logs``: get_logger_levels)
+            score = matcher.match(text) if text != view and matches(query.lstrip(":"), text) else 0
             if score > 0:
-                yield Hit(score * 0.99, matcher.highlight(text), command, help=help_text)
+                yield Hit(score, matcher.highlight(text), command, help=help_text)

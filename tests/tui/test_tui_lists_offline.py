@@ -67,3 +67,39 @@ def test_end_then_restart_restarts_the_last_process(monkeypatch) -> None:
             await until(pilot, lambda: bool(run.requests), what="the restart asked")
             assert run.requests == [("restart", "talker")]
     asyncio.run(test())
+
+
+async def palette_entries(app, pilot, typed: str) -> list[str]:
+    """The palette's entries once ``typed`` is in it."""
+    from textual.command import CommandInput, CommandList, CommandPalette
+
+    await pilot.press("colon")
+    await until(pilot, lambda: isinstance(app.screen, CommandPalette) and isinstance(app.focused, CommandInput),
+                what="the command palette")
+    await pilot.press(*typed)
+    palette = app.screen
+    await until(pilot, lambda: palette.query_one(CommandInput).value == typed
+                and palette.query_one(CommandList).option_count > 0, what="the palette's entries")
+    await pilot.pause(0.5)  # the search's last entries
+    entries = palette.query_one(CommandList)
+    return [str(entries.get_option_at_index(i).prompt).split("\n")[0] for i in range(entries.option_count)]
+
+
+def test_the_palette_lists_a_command_without_unrelated_names() -> None:
+    """Typing ``logs`` gave the command, then services whose names hold the letters l, o, g, s in order."""
+    services = [{"name": f"/{node}/{service}", "types": ["rcl_interfaces/srv/X"]}
+                for node in ("talker", "listener") for service in ("get_logger_levels", "set_logger_levels",
+                                                                    "list_parameters", "get_parameters")]
+    snapshot = {**EMPTY, "nodes": [{"name": "logs_keeper", "namespace": "/", "full_name": "/logs_keeper"}],
+                "services": services}
+
+    async def test() -> None:
+        app = RocApp(feed=DataFeed(snapshot))
+        async with app.run_test(size=(120, 35)) as pilot:
+            await until(pilot, lambda: app.graph_screen.snapshot is not None, what="the graph")
+            assert await palette_entries(app, pilot, "logs") == ["logs", "node /logs_keeper"]
+            await pilot.press("escape")
+            await until(pilot, lambda: screen_name(app) == "GraphScreen", what="the palette closed")
+            assert sorted(await palette_entries(app, pilot, "set_logger")) == [
+                "service /listener/set_logger_levels", "service /talker/set_logger_levels"]
+    asyncio.run(test())
