@@ -65,11 +65,12 @@ class ConsoleHandler:
     def __init__(self, stream: TextIO = sys.stdout, *, start_end: bool = True, stderr: bool = True,
                  summary: bool = True, direct: bool = False, cohesion: bool = False, log_path: str | None = None,
                  status=None, kind: str = "build", cached_label: str = "up to date (not rebuilt)",
-                 finished_note=None, noun: str = "package"):
+                 finished_note=None, failed_note=None, noun: str = "package"):
         self.stream = stream
         self.noun = noun  # what a task of the run's own kind is, in the summary
         self.cached_label = cached_label  # how the summary names tasks that finished without running
         self.finished_note = finished_note  # (task key) -> text appended to its "Finished" line
+        self.failed_note = failed_note  # (task key, its stderr) -> text appended to its "Failed" line
         self.status = status  # a StatusLine on a terminal: lines are printed above it
         self.start_end, self.stderr, self.summary = start_end, stderr, summary
         self.direct, self.cohesion = direct, cohesion
@@ -164,6 +165,8 @@ class ConsoleHandler:
             self.failed.append(name)
             reason = event.reason.strip().splitlines()[-1] if event.reason.strip() else "failed"
             line = f"Failed   <<< {name} [{format_duration(event.duration)}, {reason}]"
+            if self.failed_note:
+                line += self.failed_note(key, self._stderr.get(key, b"").decode(errors="replace"))
         else:
             self.aborted.append(name)
             line = f"Aborted  <<< {name} [{format_duration(event.duration)}]"

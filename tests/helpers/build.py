@@ -76,15 +76,18 @@ def copy_fixture(name: str, destination: Path) -> Path:
     return destination
 
 
-def add_cmake_package(workspace: Path, name: str, cmakelists: str, depends: tuple[str, ...] = ()) -> None:
-    """A plain CMake package ``src/NAME`` with this CMakeLists.txt and ``<depend>``s."""
+def add_cmake_package(workspace: Path, name: str, cmakelists: str, depends: tuple[str, ...] = (),
+                      test_depends: tuple[str, ...] = (), build_type: str = "cmake") -> None:
+    """A CMake package ``src/NAME`` (plain, or ``build_type`` ament_cmake) with this CMakeLists.txt,
+    ``<depend>``s and ``<test_depend>``s."""
     directory = workspace / "src" / name
     directory.mkdir(parents=True)
     deps = "".join(f"<depend>{d}</depend>" for d in depends)
+    deps += "".join(f"<test_depend>{d}</test_depend>" for d in test_depends)
     (directory / "package.xml").write_text(
         f'<?xml version="1.0"?><package format="3"><name>{name}</name><version>0.0.1</version>'
         f'<description>test</description><maintainer email="roc@example.com">roc</maintainer>'
-        f"<license>Apache-2.0</license>{deps}<export><build_type>cmake</build_type></export></package>")
+        f"<license>Apache-2.0</license>{deps}<export><build_type>{build_type}</build_type></export></package>")
     (directory / "CMakeLists.txt").write_text(cmakelists)
 
 

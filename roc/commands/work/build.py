@@ -138,6 +138,17 @@ def warn_about_missing_dependencies(workspace) -> None:
         warn(f"'{name}', a dependency of {', '.join(users)}, is in neither the workspace nor an underlay; {hint}")
 
 
+def failure_note(workspace, key: str, stderr: str) -> str:
+    """What the console adds to a failed package's line: how to go on, when roc knows the cause."""
+    from roc import distribution
+    from roc.builder.failure_hints import failure_hint
+
+    package = workspace.by_name.get(key)  # None for a task of another kind (idl:pkg)
+    found = distribution.detected() if package else None
+    hint = failure_hint(stderr, package, workspace.by_name, found[0] if found else None) if package else ""
+    return f": {hint}" if hint else ""
+
+
 def remote_cache(args: argparse.Namespace, workspace, options):
     """The run's RemoteCache, or None when the remote cache is off or not configured. The environment
     wins over roc.toml; the command line over both. (``roc work test`` has only ``--remote-cache``.)"""
@@ -301,7 +312,8 @@ def _build(args, workspace, options, switches: dict[str, bool], remote, compiler
     workers = 1 if args.executor == "sequential" else args.parallel_workers
     durations = DurationStore(options.build_base / DURATIONS_FILE)
     jobserver = Jobserver(options.jobs)
-    handlers = [*output_handlers(args, switches, workspace.root, options.build_base, console=extra_handlers is None),
+    handlers = [*output_handlers(args, switches, workspace.root, options.build_base, console=extra_handlers is None,
+                                 failed_note=partial(failure_note, workspace)),
                 durations, *(extra_handlers or [])]
     try:
         tasks = plan_build(workspace, options, jobserver, durations.durations, remote, compiler, cluster)
