@@ -19,6 +19,10 @@ import os
 import tempfile
 from typing import Any
 
+# The methods replaced below are typed in launch_ros (mypy: method-assign) when the launch system is installed
+# (scripts/setup.sh installs it from ../shared/oracles, when that is there) and Any when it is not; so their
+# ignores also allow being unused, and mypy passes either way.
+
 
 def _temporary_parameters(command: list[str]) -> dict[str, Any]:
     """The parameter files launch_ros wrote for this start (``launch_params_*``), read and removed: a real
@@ -75,7 +79,7 @@ def _quick_timers() -> None:
     try:
         from launch_ros.actions import RosTimer
 
-        RosTimer._wait_to_fire_event = wait_to_fire_event  # type: ignore[method-assign]
+        RosTimer._wait_to_fire_event = wait_to_fire_event  # type: ignore[method-assign, unused-ignore]
     except ImportError:
         pass
 
@@ -110,7 +114,7 @@ def explain(path: str, arguments: list[tuple[str, str]], debug: bool) -> tuple[i
         from launch_ros.actions import ComposableNodeContainer, LifecycleNode, LoadComposableNodes, Node
 
         # a lifecycle node's state monitoring needs the launch's own ROS node: only its process is wanted
-        LifecycleNode.execute = Node.execute  # type: ignore[method-assign]
+        LifecycleNode.execute = Node.execute  # type: ignore[method-assign, unused-ignore]
 
         def load(action, context):
             target = action._LoadComposableNodes__target_container
@@ -124,7 +128,7 @@ def explain(path: str, arguments: list[tuple[str, str]], debug: bool) -> tuple[i
             container["loads"] += _loads(action, context)
             return None
 
-        LoadComposableNodes.execute = load  # type: ignore[method-assign]
+        LoadComposableNodes.execute = load  # type: ignore[method-assign, unused-ignore]
     except ImportError:
         pass
     with tempfile.TemporaryDirectory(prefix="roc-explain-") as logs:
