@@ -36,6 +36,12 @@ class Topic:
     type_description_hash: str = ""
 
     @property
+    def transient_local(self) -> bool:
+        """Offered transient local (``/tf_static``, ``/map``): a split recording may repeat its latest
+        messages at the start of each file (roc.bag.writer)."""
+        return any(profile.get("durability") == "transient_local" for profile in self.offered_qos_profiles)
+
+    @property
     def is_service_event(self) -> bool:
         """A service's event topic (``/svc/_service_event`` of type ``pkg/srv/Name_Event``)."""
         return (self.name.endswith(SERVICE_EVENT_SUFFIX) and "/srv/" in self.type

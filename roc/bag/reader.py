@@ -90,6 +90,43 @@ def metadata_from_summaries(storage: str, summaries: list[tuple[str, FileSummary
         custom_data=embedded.custom_data if embedded else {}, ros_distro=embedded.ros_distro if embedded else "")
 
 
+class RepeatedCopies:
+    """Tells the copies that a split recording begins each file with (``--repeat-transient-local``, roc's or
+    rosbag2's) from the original messages: a message of a transient local topic, logged at the start time of
+    a file after the first, whose bytes are those of a message of the topic met before it. Called on
+    each message of one pass over the bag, in time order: a copy whose original came before the pass's
+    start is no copy for it (a playback that starts in the middle of the bag needs it)."""
+
+    def __init__(self, bag: Bag) -> None:
+        self.topics = {topic.name for topic in bag.topics() if topic.transient_local}
+        self.file_starts = {f.starting_time for f in bag.metadata.files[1:] if f.message_count}
+        self.seen: dict[str, set[bytes]] = {}  # of the transient local topics: few messages each
+
+    @property
+    def possible(self) -> bool:
+        return bool(self.topics and self.file_starts)
+
+    def __call__(self, message: Message) -> bool:
+        if message.topic not in self.topics:
+            return False
+        seen = self.seen.setdefault(message.topic, set())
+        if message.log_time in self.file_starts and message.data in seen:
+            return True
+        seen.add(message.data)
+        return False
+
+
+def repeated_copies(bag: Bag) -> dict[str, int]:
+    """How many of each topic's messages are copies a split recording repeated (RepeatedCopies)."""
+    is_copy = RepeatedCopies(bag)
+    counted: dict[str, int] = {}
+    if is_copy.possible:
+        for message in bag.messages(sorted(is_copy.topics)):
+            if is_copy(message):
+                counted[message.topic] = counted.get(message.topic, 0) + 1
+    return counted
+
+
 class Bag:
     """A bag opened for reading; ``storage`` forces the storage (else found from the files)."""
 

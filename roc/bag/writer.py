@@ -56,8 +56,7 @@ class WriteOptions:
         """How many of ``topic``'s latest messages begin each file (0: none)."""
         if topic.name in self.repeat_transient_local:
             return self.repeat_transient_local[topic.name]
-        latched = any(profile.get("durability") == "transient_local" for profile in topic.offered_qos_profiles)
-        return self.repeat_all_transient_local if latched else 0
+        return self.repeat_all_transient_local if topic.transient_local else 0
 
 
 def check_options(options: WriteOptions) -> None:

@@ -1,8 +1,9 @@
 """A bag (``roc tui --bag PATH``, ``:bag PATH``): its topics with their types, counts and rates (roc.bag,
-no rclpy); Enter steps through a topic's messages (``n``/``b``: next, back; the daemon decodes them);
-``P`` plays the bag on the live graph with ``roc bag play`` in a child process (the player imports rclpy)
-whose own keys the screen passes on: Space pauses, ``.`` plays the next message, ``>``/``<`` change the
-rate; ``x`` stops it."""
+no rclpy; the copies a split recording repeats of transient local messages are not counted); Enter
+steps through a topic's messages (``n``/``b``: next, back; the daemon decodes them); ``P`` plays the
+bag on the live graph with ``roc bag play`` in a child process (the player imports rclpy) whose own
+keys the screen passes on: Space pauses, ``.`` plays the next message, ``>``/``<`` change the rate;
+``x`` stops it."""
 
 from __future__ import annotations
 
@@ -24,6 +25,7 @@ from textual.screen import Screen
 from textual.widgets import DataTable, Footer, Static
 
 from roc.errors import RocError, UsageError
+from roc.render import plural
 from roc.tui.model import Row, rate_text
 from roc.tui.widgets import ListTable, host
 
@@ -31,11 +33,14 @@ from roc.tui.widgets import ListTable, host
 PLAYER_KEYS = {"pause": b" ", "step": b"\x1b[C", "faster": b"\x1b[A", "slower": b"\x1b[B"}
 
 
-def topic_rows(bag) -> list[Row]:
+def topic_rows(bag, copies: dict[str, int]) -> list[Row]:
+    """Each topic with its messages counted and its rate, less the ``copies`` a split recording repeated
+    (roc.bag.reader.repeated_copies): /tf_static recorded once is one message, at no rate."""
     seconds = bag.metadata.duration / 1e9
+    counts = [(topic, count - copies.get(topic.name, 0)) for topic, count in bag.metadata.topics]
     return [Row(topic.name, (topic.name, topic.type, str(count),
                              rate_text(count / seconds if seconds > 0 and count > 1 else None)))
-            for topic, count in bag.metadata.topics]
+            for topic, count in counts]
 
 
 class Playback:
@@ -116,7 +121,7 @@ class BagScreen(Screen):
         yield Footer()
 
     def on_mount(self) -> None:
-        from roc.bag.reader import Bag
+        from roc.bag.reader import Bag, repeated_copies
 
         try:
             self.bag = Bag(self.path)
@@ -124,17 +129,23 @@ class BagScreen(Screen):
             self.query_one("#title", Static).update(Text(f"bag {self.path}: {error}", style="bold red"))
             return
         metadata = self.bag.metadata
+        copies = repeated_copies(self.bag)
+        repeated = sum(copies.values())
         self.query_one("#title", Static).update(Text(
-            f"bag {self.path}  {metadata.storage_identifier}, {sum(c for _, c in metadata.topics)} messages, "
-            f"{metadata.duration / 1e9:.1f} s", style="bold"))
-        self.query_one("#topics", ListTable).show(topic_rows(self.bag))
+            f"bag {self.path}  {metadata.storage_identifier}, "
+            f"{plural(sum(c for _, c in metadata.topics) - repeated, 'message')}, {metadata.duration / 1e9:.1f} s"
+            + (f" ({repeated} repeated at the start of split files not counted)" if repeated else ""), style="bold"))
+        self.query_one("#topics", ListTable).show(topic_rows(self.bag, copies))
         self.query_one("#topics").focus()
         self.set_interval(0.5, self.draw_playback)
 
     def on_data_table_row_selected(self, event: DataTable.RowSelected) -> None:
+        from roc.bag.reader import RepeatedCopies
+
         if self.bag is not None and event.row_key.value:
             self.topic = event.row_key.value
-            self.messages = [m.data for m in self.bag.messages([self.topic])]
+            is_copy = RepeatedCopies(self.bag)
+            self.messages = [m.data for m in self.bag.messages([self.topic]) if not is_copy(m)]
             self.index = -1
             self.action_step(1)
 

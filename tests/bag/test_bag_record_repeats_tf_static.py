@@ -78,3 +78,21 @@ def test_each_split_file_plays_alone_with_the_static_frames(recording):
     assert len(files) >= 4
     for bag_file in files[1:3]:  # split files: without the repeat these hold no /tf_static at all
         assert heard_static(bag_file, env) == STATIC, bag_file.name
+
+
+def test_the_whole_recording_plays_each_static_message_once(recording):
+    """The copies at the start of each file are for a file played alone: played whole, the bag publishes
+    /tf_static as it was recorded (ros2 bag play publishes every copy)."""
+    from roc.bag.reader import Bag, repeated_copies
+
+    bag, env = recording
+    with Bag(bag) as opened:
+        repeated = repeated_copies(opened)["/tf_static"]
+        recorded = {topic.name: count for topic, count in opened.metadata.topics}["/tf_static"]
+    assert repeated >= 3  # each file after the first begins with a copy
+    player = subprocess.run([str(BIN / "roc"), "bag", "play", str(bag), "--topics", "/tf_static",
+                             "--disable-keyboard-controls"], env=env, capture_output=True, text=True, timeout=60)
+    assert player.returncode == 0, player.stderr
+    played = recorded - repeated
+    assert f"Played {played} message{'s' if played > 1 else ''} on 1 topic" in player.stdout, player.stdout
+    assert f"Not played again: {repeated} of the transient local messages" in player.stdout, player.stdout

@@ -93,3 +93,30 @@ def write_bag_only_bag(path, count: int, definition: str = BAG_ONLY_DEFINITION) 
         writer.write("/vec", data[-1], 1_700_000_000_000_000_000 + index * 10_000_000)
     writer.close()
     return data
+
+
+def string_cdr(text: str) -> bytes:
+    """A std_msgs/msg/String as CDR (little endian), without rclpy."""
+    import struct
+
+    data = text.encode() + b"\0"
+    return b"\0\1\0\0" + struct.pack("<I", len(data)) + data
+
+
+def write_split_bag_with_tf_static(path, seconds: int = 4) -> None:
+    """A bag split every second whose files each begin with the one /tf_static message (transient local,
+    written at the start: ``--repeat-transient-local``), beside /data at 10 Hz: a std_msgs/msg/String each."""
+    from roc.bag.definitions import definition
+    from roc.bag.metadata import Topic
+    from roc.bag.qos import default_profile
+    from roc.bag.writer import BagWriter, WriteOptions
+
+    start = 1_700_000_000_000_000_000
+    writer = BagWriter(path, WriteOptions(max_bag_duration=1_000_000_000, repeat_all_transient_local=1))
+    for name, durability in (("/tf_static", "transient_local"), ("/data", "volatile")):
+        writer.add_topic(Topic(name, "std_msgs/msg/String", "cdr", [{**default_profile(), "durability": durability}]),
+                         definition("std_msgs/msg/String"))
+    writer.write("/tf_static", string_cdr("static"), start)
+    for index in range(seconds * 10):
+        writer.write("/data", string_cdr(f"data {index}"), start + 1_000_000 + index * 100_000_000)
+    writer.close()

@@ -22,7 +22,7 @@ from typing import Any
 from roc.bag.message import Message
 from roc.bag.metadata import Topic
 from roc.bag.qos import offer_for_recorded
-from roc.bag.reader import Bag
+from roc.bag.reader import Bag, RepeatedCopies
 from roc.bag.selection import Selection
 from roc.bag.transport.ros_qos import profile
 from roc.errors import RocError
@@ -64,6 +64,7 @@ class PlayResult:
     published: dict[str, int]
     lateness_ns: list[int]  # how late each message went out against its scheduled time
     skipped: list[str]
+    repeated: int = 0  # copies of transient local messages a split recording repeated, not played again
 
 
 def _absolute(name: str) -> str:
@@ -90,6 +91,7 @@ class Player:
         self._next = 0  # messages to play at once while paused (right arrow)
         self._rate = options.rate
         self._stopping = False
+        self._repeated = 0  # copies left out (RepeatedCopies)
         # The playback clock: bag time = anchor_bag + (now - anchor_wall) * rate, frozen while paused.
         self._anchor_wall = time.perf_counter_ns()
         self._anchor_bag = 0
@@ -181,8 +183,14 @@ class Player:
         return publishers, skipped
 
     def _read(self, bag: Bag, topics: list[str], start: int, end: int | None, ready: queue.Queue) -> None:
+        """Read one pass's messages into ``ready``, less the copies a split recording repeated of messages
+        this pass played (a transient local publisher keeps them for late subscribers already)."""
+        is_copy = RepeatedCopies(bag)
         try:
             for message in bag.messages(topics, start, end):
+                if is_copy(message):
+                    self._repeated += 1
+                    continue
                 while True:
                     try:
                         ready.put(message, timeout=SLICE_S)
@@ -228,7 +236,7 @@ class Player:
                         if t is not None]
                 end = min(ends) if ends else None
                 if options.wait_for_subscribers > 0 and not self._wait_for_subscribers(publishers):
-                    return PlayResult(published, lateness, skipped)
+                    return PlayResult(published, lateness, skipped, self._repeated)
                 with self._changed:
                     self._anchor(start)
                 if options.clock_hz > 0:
@@ -245,7 +253,7 @@ class Player:
             finally:
                 self.stop()
                 graph.close()
-        return PlayResult(published, lateness, skipped)
+        return PlayResult(published, lateness, skipped, self._repeated)
 
     def _wait_for_subscribers(self, publishers: dict[str, Any]) -> bool:
         """Wait until each publisher has matched as many subscriptions as asked (its own count, not the

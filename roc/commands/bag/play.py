@@ -102,6 +102,9 @@ def _selection(args: argparse.Namespace) -> Selection | None:
 def _summary(result) -> list[str]:
     total = sum(result.published.values())
     lines = [f"Played {plural(total, 'message')} on {plural(len(result.published), 'topic')}"]
+    if result.repeated:
+        lines.append(f"Not played again: {result.repeated} of the transient local messages a split recording repeats "
+                     "at the start of each file (--repeat-transient-local); their original was played")
     if result.lateness_ns:
         late = sorted(abs(x) for x in result.lateness_ns)
         p99 = late[min(len(late) - 1, int(len(late) * 0.99))]
