@@ -24,6 +24,9 @@ from roc.environment.dsv import Operation, resolve_operations
 from roc.fsutil import write_text_atomic
 
 INSTALL_LAYOUT_MARKER = ".colcon_install_layout"
+CACHE_VERSION = 2  # of prefix_operations' cache: 2 added wheel_library_operations
+# where a linker looks without LD_LIBRARY_PATH (Debian's multiarch folders included)
+SYSTEM_LIBRARY_FOLDERS = ("/lib", "/usr/lib", "/lib64", "/usr/lib64", "/usr/local/lib")
 
 
 @dataclass(frozen=True)
@@ -64,7 +67,7 @@ def prefix_operations(prefix: Path) -> tuple[Operation, ...]:
     cache = _cache_file(prefix)
     try:
         saved = json.loads(cache.read_text())
-        if saved["stamp"] == stamp:
+        if saved["stamp"] == stamp and saved.get("version") == CACHE_VERSION:
             return tuple(Operation(kind, name, tuple(values)) for kind, name, values in saved["operations"])
     except (OSError, ValueError, KeyError, TypeError):
         pass
@@ -73,11 +76,56 @@ def prefix_operations(prefix: Path) -> tuple[Operation, ...]:
         for operation in resolve_operations(prefix, prefix / "share" / name / "package.dsv"):
             if operation.kind != "source":
                 found.setdefault(operation, None)
+    for operation in wheel_library_operations(prefix):
+        found.setdefault(operation, None)
     operations = tuple(found)
     with contextlib.suppress(OSError):  # no cache: computed again next time
-        write_text_atomic(cache, json.dumps({"stamp": stamp, "operations": [
+        write_text_atomic(cache, json.dumps({"stamp": stamp, "version": CACHE_VERSION, "operations": [
             [o.kind, o.name, list(o.values)] for o in operations]}))
     return operations
+
+
+def wheel_library_operations(prefix: Path) -> list[Operation]:
+    """For ROS 2 installed from PyPI wheels into a Python environment: the library folders its C and C++
+    libraries need at run time that no package hook names. The wheels' libraries find their bundled
+    dependencies (``site-packages/ros_*.libs``: tinyxml2, spdlog, lttng-ust...) only through the
+    LD_LIBRARY_PATH their bootstrapper gives Python processes, so a C++ program run from a shell that
+    sourced a workspace would not start; and C++ programs linking rcl need the interpreter's shared
+    libpython (see roc.doctor.wheel_repairs), whose folder a pyenv or self-built Python keeps outside
+    the linker's search path."""
+    folders = sorted(prefix.glob("lib/python3*/site-packages/ros_*.libs"))
+    if not folders:
+        return []
+    operations = [Operation("prepend-non-duplicate", "LD_LIBRARY_PATH", (str(folder.relative_to(prefix)),))
+                  for folder in folders]
+    libpython = _libpython_folder(prefix)
+    if libpython is not None:
+        operations.append(Operation("prepend-non-duplicate", "LD_LIBRARY_PATH", (libpython,)))
+    return operations
+
+
+def _libpython_folder(prefix: Path) -> str | None:
+    """The folder of the shared libpython of the venv at ``prefix``'s interpreter (``home`` in its
+    pyvenv.cfg), when the linker would not look there by itself."""
+    try:
+        config = (prefix / "pyvenv.cfg").read_text()
+    except OSError:
+        return None
+    home = next((line.split("=", 1)[1].strip() for line in config.splitlines()
+                 if line.split("=", 1)[0].strip() == "home"), None)
+    if not home:
+        return None
+    folder = os.path.realpath(os.path.join(home, os.pardir, "lib"))
+    found = any(name.startswith("libpython3") and ".so" in name for name in _listdir(folder))
+    system = any(folder == root or folder.startswith(root + "/") for root in SYSTEM_LIBRARY_FOLDERS)
+    return folder if found and not system else None
+
+
+def _listdir(folder: str) -> list[str]:
+    try:
+        return os.listdir(folder)
+    except OSError:
+        return []
 
 
 def _cache_file(prefix: Path) -> Path:

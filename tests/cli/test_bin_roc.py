@@ -63,6 +63,16 @@ def test_sets_the_bootstrappers_library_path_and_flag_and_passes_arguments_untou
     assert seen["ARG"] == ["topic", "echo", "a b", "--x=*"]
 
 
+def test_keeps_the_order_of_library_folders_a_sourced_workspace_listed(tmp_path):
+    venv = fake_venv(tmp_path)
+    site = venv / "lib" / "python3.11" / "site-packages"
+    # a workspace's setup script put its own libraries before the venv's, and one ros_*.libs folder
+    sourced = f"/ws/install/rclcpp/lib:{venv}/lib:{site}/ros_rcl.libs"
+    seen = run([str(venv / "bin" / "roc"), "--version"], plain_environment(LD_LIBRARY_PATH=sourced))
+    assert seen["LD_LIBRARY_PATH"] == [f"{site}/ros_rclpy.libs:{sourced}"]
+    assert seen["FLAG"] == ["1"]
+
+
 def test_changes_nothing_where_no_bootstrapper_is_installed_or_it_already_ran(tmp_path):
     venv = fake_venv(tmp_path, with_bootstrapper=False)
     assert run([str(venv / "bin" / "roc")], plain_environment()) == {"LD_LIBRARY_PATH": ["<unset>"],
