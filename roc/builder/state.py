@@ -59,3 +59,26 @@ def install_intact(prefix: Path, name: str, build_dir: Path) -> bool:
             if line and not line.endswith(".pyc") and not os.path.lexists(line):
                 return False
     return True
+
+
+SAID_FILE = "roc_said.json"  # in the build base: what was said about the workspace (not_said_yet)
+
+
+def not_said_yet(build_base: Path, stamp: str, messages: list[str]) -> list[str]:
+    """The ``messages`` about the workspace that were not said since ``stamp`` (of what they come from)
+    last changed, and remember them as said in ``build_base``: a warning about a manifest is said
+    once, not on every build (a no-op included). A file that cannot be read or written is no memory."""
+    path = build_base / SAID_FILE
+    try:
+        record = json.loads(path.read_text())
+        said = set(record["said"]) if record["stamp"] == stamp else set()
+    except (OSError, ValueError, KeyError, TypeError):
+        said = set()
+    new = [message for message in messages if message not in said]
+    if new:
+        try:
+            build_base.mkdir(parents=True, exist_ok=True)
+            write_text_atomic(path, json.dumps({"stamp": stamp, "said": sorted(said | set(new))}))
+        except OSError:
+            pass
+    return new

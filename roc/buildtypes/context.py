@@ -37,6 +37,17 @@ class BuildOptions:
     def ament_cmake_args_for(self, package: str) -> tuple[str, ...]:
         return self.ament_cmake_args + self.package_ament_cmake_args.get(package, ())
 
+    def builds_tests(self, package: str) -> bool:
+        """Whether the package's CMake arguments leave ``BUILD_TESTING`` on (ament_cmake's default;
+        ``-DBUILD_TESTING=OFF`` or another of CMake's false values turns it off)."""
+        value = "ON"
+        for arg in self.cmake_args_for(package):
+            name, _, given = arg.partition("=")
+            if name in ("-DBUILD_TESTING", "-DBUILD_TESTING:BOOL"):
+                value = given.upper()
+        false = ("", "0", "OFF", "NO", "FALSE", "N", "IGNORE", "NOTFOUND")
+        return value not in false and not value.endswith("-NOTFOUND")
+
     def partial(self) -> bool:
         """Builds that do not leave a complete, reusable install (never recorded as up to date)."""
         return bool(self.cmake_target)

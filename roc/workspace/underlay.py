@@ -11,6 +11,7 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 
 from roc.environment import path_list
+from roc.workspace.package import CATEGORIES
 
 AMENT_INDEX = Path("share", "ament_index", "resource_index", "packages")
 COLCON_INDEX = Path("share", "colcon-core", "packages")
@@ -104,13 +105,14 @@ def override_warning(overridden: Mapping[str, list[Path]]) -> str:
 PACKAGE_NAME = re.compile(r"[a-z][a-z0-9_]*")
 
 
-def missing_dependencies(packages: Iterable, known: set[str]) -> dict[str, list[str]]:
+def missing_dependencies(packages: Iterable, known: set[str],
+                         categories: tuple[str, ...] = CATEGORIES) -> dict[str, list[str]]:
     """{name: [packages depending on it]} for each dependency of ``packages`` (roc.workspace.package
-    Packages) that is not ``known`` (the workspace's and the underlays' packages) and could be a ROS
-    package's name."""
+    Packages) in ``categories`` that is not ``known`` (the workspace's and the underlays' packages) and
+    could be a ROS package's name."""
     missing: dict[str, list[str]] = {}
     for package in packages:
-        for name in sorted(package.direct_dependencies()):
+        for name in sorted(package.direct_dependencies(categories)):
             if name not in known and PACKAGE_NAME.fullmatch(name):
                 missing.setdefault(name, []).append(package.name)
     return missing

@@ -232,3 +232,56 @@ def test_a_dependency_found_nowhere_is_warned_about_once_with_the_closest_name(t
         "did you mean 'std_msgs'?"]
     only_beta = cli("work", "build", "--packages-select", "alpha", env=ros_env(), cwd=workspace)
     assert "'std_msg', a dependency of alpha, is" in only_beta.stderr
+
+
+@pytest.mark.slow
+def test_a_missing_dependency_is_warned_about_once_until_a_manifest_of_the_workspace_changes(tmp_path: Path) -> None:
+    workspace = tmp_path / "ws"
+    _package(workspace, "alpha", ("eigen",))
+    _package(workspace, "beta")
+    warning = "roc: warning: 'eigen', a dependency of alpha, is in neither the workspace nor an underlay"
+    assert warning in cli("work", "build", env=ros_env(), cwd=workspace).stderr
+    again = cli("work", "build", env=ros_env(), cwd=workspace)  # a no-op
+    assert again.returncode == 0 and again.stderr == "", again.stderr
+    manifest = workspace / "src" / "beta" / "package.xml"
+    manifest.write_text(manifest.read_text().replace("0.0.1", "0.0.2"))
+    assert warning in cli("work", "build", env=ros_env(), cwd=workspace).stderr
+
+
+@pytest.mark.slow
+def test_a_package_is_never_suggested_as_its_own_missing_dependency(tmp_path: Path) -> None:
+    workspace = tmp_path / "ws"
+    _package(workspace, "lifecycle_py", ("lifecycle",))  # 0.86 alike: the closest name, but its own
+    built = cli("work", "build", env=ros_env(), cwd=workspace)
+    assert built.stderr.splitlines() == [
+        "roc: warning: 'lifecycle', a dependency of lifecycle_py, is in neither the workspace nor an underlay; "
+        "a typo? (a system dependency that rosdep installs is fine)"]
+
+
+@pytest.mark.slow
+def test_missing_test_dependencies_are_one_note_and_none_on_a_build_without_tests(tmp_path: Path) -> None:
+    workspace = tmp_path / "ws"
+    lint_dependencies = ("ament_lint_auto", "ament_lint_common")
+    add_cmake_package(workspace, "alpha", "cmake_minimum_required(VERSION 3.8)\nproject(alpha NONE)\n",
+                      test_depends=(*lint_dependencies, "lifecycle"))
+    add_cmake_package(workspace, "beta", "cmake_minimum_required(VERSION 3.8)\nproject(beta NONE)\n",
+                      test_depends=lint_dependencies)
+    without_tests = cli("work", "build", "--cmake-args", "-DBUILD_TESTING=OFF", env=ros_env(), cwd=workspace)
+    assert without_tests.returncode == 0 and without_tests.stderr == "", without_tests.stderr
+    built = cli("work", "build", env=ros_env(), cwd=workspace)
+    assert built.stderr.splitlines() == [
+        "roc: note: 3 test dependencies in neither the workspace nor an underlay, needed only to build and run the "
+        "tests (--cmake-args -DBUILD_TESTING=OFF builds without them): ament_lint_auto (of alpha, beta), "
+        "ament_lint_common (of alpha, beta), lifecycle (of alpha)"]
+
+
+def test_a_build_without_tests_is_told_by_any_of_cmakes_false_values_for_build_testing(tmp_path: Path) -> None:
+    from roc.buildtypes.context import BuildOptions
+
+    def builds_tests(*cmake_args: str, **per_package: tuple[str, ...]) -> bool:
+        return BuildOptions(tmp_path, tmp_path, cmake_args=cmake_args, package_cmake_args=per_package).builds_tests("a")
+
+    assert builds_tests() and builds_tests("-DBUILD_TESTING=ON") and builds_tests("-DBUILD_TESTING_X=OFF")
+    assert not builds_tests("-DBUILD_TESTING=OFF") and not builds_tests("-DBUILD_TESTING:BOOL=0")
+    assert not builds_tests("-DBUILD_TESTING=no") and not builds_tests(a=("-DBUILD_TESTING=FALSE",))
+    assert builds_tests("-DBUILD_TESTING=OFF", a=("-DBUILD_TESTING=ON",))  # the package's own arguments come last

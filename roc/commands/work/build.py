@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 import threading
+import zlib
 from functools import partial
 from pathlib import Path
 
@@ -123,19 +125,56 @@ def warn_about_overrides(args: argparse.Namespace, workspace, install_base: Path
         warn(override_warning(overridden))
 
 
-def warn_about_missing_dependencies(workspace) -> None:
-    """One warning per dependency of the selected packages that neither the workspace nor an underlay
-    has (colcon builds on silently): a typo, most likely, or a system dependency."""
+def warn_about_missing_dependencies(workspace, options) -> None:
+    """Dependencies of the selected packages that neither the workspace nor an underlay has (colcon
+    builds on silently): a warning for each build or run dependency (a typo, most likely, or a system
+    dependency), with the closest known name that is not a package depending on it; and one quieter
+    note for the test dependencies of the packages that build their tests, which only the tests need.
+    Each is said once until a manifest of the workspace changes (roc.builder.state.not_said_yet)."""
     from roc.builder.environment import base_environment
+    from roc.builder.state import not_said_yet
     from roc.messages import PACKAGE_NAME_CUTOFF, did_you_mean, warn
+    from roc.render import print_text
     from roc.workspace.underlay import missing_dependencies, underlay_packages
 
     known = set(workspace.by_name) | set(underlay_packages(base_environment()))
     selected = [workspace.by_name[name] for name in sorted(workspace.selected)]
-    for name, users in missing_dependencies(selected, known).items():
-        hint = did_you_mean(name, known, count=1, cutoff=PACKAGE_NAME_CUTOFF) or (
+    needed = missing_dependencies(selected, known, ("build", "run"))
+    warnings = []
+    for name, users in needed.items():
+        hint = did_you_mean(name, known - set(users), count=1, cutoff=PACKAGE_NAME_CUTOFF) or (
             "a typo? (a system dependency that rosdep installs is fine)")
-        warn(f"'{name}', a dependency of {', '.join(users)}, is in neither the workspace nor an underlay; {hint}")
+        warnings.append(f"'{name}', a dependency of {', '.join(users)}, is in neither the workspace nor an underlay; "
+                        f"{hint}")
+    testing = [package for package in selected if options.builds_tests(package.name)]
+    tested = {name: users for name, users in missing_dependencies(testing, known, ("test",)).items()
+              if name not in needed}
+    notes = []
+    if tested:
+        count = f"{len(tested)} test {'dependency' if len(tested) == 1 else 'dependencies'}"
+        notes.append(f"{count} in neither the workspace nor an underlay, needed "
+                     "only to build and run the tests (--cmake-args -DBUILD_TESTING=OFF builds without them): "
+                     + ", ".join(f"{name} (of {', '.join(users)})" for name, users in tested.items()))
+    said = not_said_yet(options.build_base, _manifests_stamp(workspace),
+                        [f"warning: {text}" for text in warnings] + [f"note: {text}" for text in notes])
+    for text in warnings:
+        if f"warning: {text}" in said:
+            warn(text)
+    for text in notes:
+        if f"note: {text}" in said:
+            print_text(f"roc: note: {text}\n", sys.stderr)
+
+
+def _manifests_stamp(workspace) -> str:
+    """What changes when a manifest of the workspace changes: the time and size of each package.xml."""
+    stamps, root = [], str(workspace.root)
+    for package in workspace.ordered:
+        try:
+            info = os.stat(os.path.join(root, package.path_text, "package.xml"))
+        except OSError:
+            continue
+        stamps.append((package.name, info.st_mtime_ns, info.st_size))
+    return f"{zlib.crc32(repr(stamps).encode()):08x}"
 
 
 def failure_note(workspace, key: str, stderr: str) -> str:
@@ -207,7 +246,7 @@ def run(args: argparse.Namespace) -> int:
     if args.explain:
         return _explain(args, workspace, options, remote)
     warn_about_overrides(args, workspace, options.install_base)
-    warn_about_missing_dependencies(workspace)
+    warn_about_missing_dependencies(workspace, options)
     build = partial(_locked_build, args, workspace, options, switches, remote)
     if args.tui:
         from roc.tui.app import run_build_app
