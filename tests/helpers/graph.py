@@ -146,38 +146,49 @@ INSTALLER_ENV = {**os.environ, "ROS_WHEELS_DISTRO": DISTRO}
 def install_oracle(launch: bool = False) -> str | None:
     """Install the real ros2 CLI and the tests' message packages into the cached venv (with ``launch``, also
     the real launch system and ``ros2 launch``); the reason it failed, or None. One installer at a time
-    (pytest-xdist workers share the venv)."""
+    (pytest-xdist workers share the venv). Each part is marked installed once it is all there (INSTALLED):
+    a venv whose ros2 CLI is not marked (an install stopped or failed halfway, which the installer would
+    take as done) is made again from nothing."""
     import fcntl
 
     ORACLE_VENV.parent.mkdir(parents=True, exist_ok=True)
     with open(ORACLE_VENV.parent / f"{ORACLE_VENV.name}.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        return _install_ros2cli() or (_install_launch() if launch else None)
+        return _install("ros2cli", _install_ros2cli) or (_install("launch", _install_launch) if launch else None)
 
 
-def _oracle_imports(modules: str) -> bool:
-    return subprocess.run([str(ORACLE_VENV / "bin" / "python"), "-c", f"import {modules}"], capture_output=True,
-                          env={**os.environ, "_ROS_WHEELS_BOOTSTRAP_COMPLETE": "1"}).returncode == 0
+# The marker of each part of the oracle venv, written when its install has finished.
+INSTALLED = ".roc-installed-{part}"
+
+
+def _install(part: str, install) -> str | None:
+    """Run ``install`` unless ``part`` is marked installed; mark it when ``install`` succeeds."""
+    marker = ORACLE_VENV / INSTALLED.format(part=part)
+    if marker.exists():
+        return None
+    reason = install()
+    if reason is None:
+        marker.touch()
+    return reason
 
 
 def _install_ros2cli() -> str | None:
-    python = ORACLE_VENV / "bin" / "python"
-    if (ORACLE_VENV / "bin" / "ros2").exists() and _oracle_imports("geometry_msgs.msg, test_msgs.msg, std_srvs.srv"):
-        return None
+    import shutil
+
     script = require_oracle("ros2 CLI (its installer)", SHARED / "oracles" / "install_ros2cli.sh")
-    if not python.exists():
-        base = getattr(sys, "_base_executable", sys.executable)
-        made = subprocess.run([base, "-m", "venv", str(ORACLE_VENV)], capture_output=True, text=True)
-        if made.returncode != 0:
-            return f"cannot create {ORACLE_VENV}: {made.stderr.strip()}"
+    shutil.rmtree(ORACLE_VENV, ignore_errors=True)
+    base = getattr(sys, "_base_executable", sys.executable)
+    made = subprocess.run([base, "-m", "venv", str(ORACLE_VENV)], capture_output=True, text=True)
+    if made.returncode != 0:
+        return f"cannot create {ORACLE_VENV}: {made.stderr.strip()}"
     installed = subprocess.run(["bash", str(script), str(ORACLE_VENV)], capture_output=True, text=True, timeout=900,
                                env=INSTALLER_ENV)
     if installed.returncode != 0:
         return f"install_ros2cli.sh failed: {installed.stderr.strip()[-300:]}"
     pins = [line.strip() for line in REQUIREMENTS.read_text().splitlines()
             if line.strip().startswith(tuple(f"{name}==" for name in ORACLE_INTERFACES))]
-    added = subprocess.run([str(python), "-m", "pip", "install", "-q", *pins], capture_output=True, text=True,
-                           timeout=900)
+    added = subprocess.run([str(ORACLE_VENV / "bin" / "python"), "-m", "pip", "install", "-q", *pins],
+                           capture_output=True, text=True, timeout=900)
     if added.returncode != 0:
         return f"installing {' '.join(pins)} into the oracle failed: {added.stderr.strip()[-300:]}"
     return None
@@ -186,9 +197,8 @@ def _install_ros2cli() -> str | None:
 def _install_launch() -> str | None:
     """``ros2 launch`` in the oracle venv. install_launch.sh builds composition_interfaces with CMake, which
     needs what roc's own venv has for that: the wheels of requirements/ros-DISTRO.txt with their CMake
-    fix-ups, and catkin_pkg (ament_cmake reads package.xml with it; roc's venv has it through colcon)."""
-    if (ORACLE_VENV / "bin" / "ros2").exists() and _oracle_imports("ros2launch, launch_ros, launch_xml, launch_yaml"):
-        return None
+    fix-ups, and catkin_pkg (ament_cmake reads package.xml with it; roc's venv has it through colcon).
+    Every step may run again over a half-done one (the installer completes a half-installed launch)."""
     script = SHARED / "oracles" / "install_launch.sh"
     if not script.is_file():
         return f"no launch installer at {script}"

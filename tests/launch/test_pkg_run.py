@@ -5,8 +5,10 @@ signals passed back (roc becomes the node), one-line errors listing what exists.
 from __future__ import annotations
 
 import json
+import os
 import signal
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -47,12 +49,17 @@ def test_pkg_prints_what_ros2_pkg_prints(demo, oracle, verb: list[str]) -> None:
     assert ours.stdout
 
 
-def test_pkg_json_and_the_prefixes_it_covers(demo) -> None:
+def test_pkg_json_and_the_prefixes_it_covers(demo, tmp_path: Path) -> None:
     env, prefix = demo
+    # a prefix between the overlay and the wheels' venv, made here (not the oracle's venv, which may be
+    # missing or half-installed on a fresh machine)
+    other = tmp_path / "other"
+    (other / "share" / "ament_index" / "resource_index" / "packages").mkdir(parents=True)
+    (other / "share" / "ament_index" / "resource_index" / "packages" / "other_pkg").touch()
+    env = {**env, "AMENT_PREFIX_PATH": os.pathsep.join([str(prefix), str(other), sys.prefix])}
     listed = json.loads(roc("pkg", "list", "--format", "json", env=env).stdout)
     where = {entry["name"]: entry["prefix"] for entry in listed}
-    assert where[PACKAGE] == str(prefix)  # the sourced overlay
-    assert where["rclpy"] != str(prefix) and "ros2cli" in where  # the wheels' venv and the oracle's
+    assert (where[PACKAGE], where["other_pkg"], where["rclpy"]) == (str(prefix), str(other), sys.prefix)
     executables = json.loads(roc("pkg", "executables", PACKAGE, "--format", "json", env=env).stdout)
     assert [e["executable"] for e in executables] == ["args", "crasher", "listener", "server", "talker"]
     assert executables[0]["path"] == str(prefix / "lib" / PACKAGE / "args")
