@@ -4,10 +4,11 @@ on. The error texts are CMake's own, as ament_cmake 2.5.4 (Jazzy's wheels) print
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pytest
-from helpers.build import DISTRO, add_cmake_package, roc
+from helpers.build import DISTRO, add_cmake_package, colcon, roc
 
 from roc.builder.failure_hints import failure_hint
 from roc.workspace.package import Package
@@ -117,3 +118,54 @@ def test_the_console_line_of_a_package_that_needs_ament_lint_auto_says_how_to_go
                          f"tests (--cmake-args -DBUILD_TESTING=OFF), or install ros-{DISTRO}-ament-lint-auto"), line
     built = roc("work", "build", "--cmake-args", "-DBUILD_TESTING=OFF", cwd=workspace)
     assert built.returncode == 0, built.stdout + built.stderr
+
+
+def add_python_package(workspace: Path, name: str, test_depends: tuple[str, ...]) -> None:
+    directory = workspace / "src" / name
+    (directory / name).mkdir(parents=True)
+    (directory / name / "__init__.py").write_text("")
+    (directory / "resource").mkdir()
+    (directory / "resource" / name).write_text("")
+    (directory / "package.xml").write_text(
+        f'<?xml version="1.0"?><package format="3"><name>{name}</name><version>0.0.1</version>'
+        f'<description>test</description><maintainer email="roc@example.com">roc</maintainer>'
+        f"<license>Apache-2.0</license>{''.join(f'<test_depend>{d}</test_depend>' for d in test_depends)}"
+        f"<export><build_type>ament_python</build_type></export></package>")
+    (directory / "setup.py").write_text(
+        f"from setuptools import setup\nsetup(name='{name}', version='0.0.1', packages=['{name}'], data_files=["
+        f"('share/ament_index/resource_index/packages', ['resource/{name}']), ('share/{name}', ['package.xml'])])\n")
+
+
+@pytest.mark.slow
+@pytest.mark.colcon
+def test_packages_select_builds_a_package_whose_test_dependency_is_not_built_where_colcon_refuses(
+        tmp_path: Path) -> None:
+    workspace = tmp_path / "ws"
+    add_cmake_package(workspace, "tdep", "cmake_minimum_required(VERSION 3.8)\nproject(tdep NONE)\n"
+                      "find_package(ament_cmake REQUIRED)\nament_package()\n",
+                      depends=("ament_cmake",), build_type="ament_cmake")
+    add_python_package(workspace, "userpy", test_depends=("tdep",))
+    add_cmake_package(workspace, "user", "cmake_minimum_required(VERSION 3.8)\nproject(user NONE)\n"
+                      "find_package(ament_cmake REQUIRED)\nif(BUILD_TESTING)\n  find_package(tdep REQUIRED)\nendif()\n"
+                      "ament_package()\n", depends=("ament_cmake",), test_depends=("tdep",), build_type="ament_cmake")
+    colcon_copy = tmp_path / "colcon"
+    shutil.copytree(workspace, colcon_copy)
+
+    refused = colcon("build", "--packages-select", "userpy", cwd=colcon_copy)
+    assert "Check that the following packages have been built:\n- tdep" in refused.stderr, refused.stderr
+    assert not (colcon_copy / "install" / "userpy" / "share" / "userpy" / "package.xml").exists()
+
+    built = roc("work", "build", "--packages-select", "userpy", cwd=workspace)  # its build does not need tdep
+    assert built.returncode == 0, built.stdout + built.stderr
+    assert (workspace / "install" / "userpy" / "share" / "userpy" / "package.xml").is_file()
+
+    # a CMakeLists that finds its test dependency while BUILD_TESTING is on cannot configure without it
+    failed = roc("work", "build", "--packages-select", "user", cwd=workspace)
+    assert failed.returncode == 1
+    assert "CMake configure failed]: tdep is in the workspace but not built: build it too (--packages-up-to user), or " \
+           "build without tests (--cmake-args -DBUILD_TESTING=OFF)" in failed.stdout, failed.stdout
+    without_tests = roc("work", "build", "--packages-select", "user", "--cmake-args", "-DBUILD_TESTING=OFF",
+                        cwd=workspace)
+    assert without_tests.returncode == 0, without_tests.stdout + without_tests.stderr
+    up_to = roc("work", "build", "--packages-up-to", "user", cwd=workspace)
+    assert up_to.returncode == 0, up_to.stdout + up_to.stderr
