@@ -28,12 +28,13 @@ from roc.tui.widgets import ListTable, host
 REFRESH_SECONDS = 1.0
 # the topics' columns whose values change every second, at the widths of their longest values
 WIDTHS = {"topics": {"pub": 3, "sub": 3, "rate": 9, "bandwidth": 11}, "nodes": {"cpu": 6, "mem": 5}}
-# list -> (columns, marks); nodes and topics side by side in the first tab, the others a tab each
+# list -> (columns, marks, the columns cut to fit the screen); nodes and topics side by side in the first
+# tab, the others a tab each
 LISTS = {
-    "nodes": (("node", "cpu", "mem"), True),
-    "topics": (("topic", "pub", "sub", "rate", "bandwidth", "type"), True),
-    "services": (("service", "type"), False),
-    "actions": (("action", "type"), False),
+    "nodes": (("node", "cpu", "mem"), True, ("node",)),
+    "topics": (("topic", "pub", "sub", "rate", "bandwidth", "type"), True, ("topic", "type")),
+    "services": (("service", "type"), False, ("service", "type")),
+    "actions": (("action", "type"), False, ("action", "type")),
 }
 SYSTEM = ("nodes", "topics")
 NARROW = 100  # below this many columns, the nodes are above the topics instead of beside them
@@ -78,9 +79,10 @@ class GraphScreen(Screen):
     GraphScreen #tabs { height: 1fr; }
     GraphScreen #system { layout: horizontal; height: 1fr; }
     GraphScreen #system.narrow { layout: vertical; }
-    GraphScreen #system #nodes-table { width: 36; }
-    GraphScreen #system.narrow #nodes-table { width: 1fr; height: 2fr; }
-    GraphScreen #system.narrow #topics-table { height: 3fr; }
+    GraphScreen #system #nodes-table { width: 1fr; min-width: 36; max-width: 64; }
+    GraphScreen #system #topics-table { width: 2fr; }
+    GraphScreen #system.narrow #nodes-table { width: 1fr; max-width: 100%; height: 2fr; }
+    GraphScreen #system.narrow #topics-table { width: 1fr; height: 3fr; }
     """
 
     def __init__(self, workspace=None, checks=None) -> None:
@@ -120,8 +122,8 @@ class GraphScreen(Screen):
 
     @staticmethod
     def list_table(name: str) -> ListTable:
-        columns, marks = LISTS[name]
-        return ListTable(columns, marks=marks, id=f"{name}-table", widths=WIDTHS.get(name))
+        columns, marks, cut = LISTS[name]
+        return ListTable(columns, marks=marks, id=f"{name}-table", widths=WIDTHS.get(name), cut_columns=cut)
 
     def on_resize(self, event: Resize) -> None:
         self.query_one("#system").set_class(event.size.width < NARROW, "narrow")

@@ -4,6 +4,7 @@ live rates and bandwidths of topics, the nodes' processes, the filter. No Textua
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -31,6 +32,37 @@ def matches(needle: str, *texts: str) -> bool:
     """The filter: every word of ``needle`` appears (any case) in one of ``texts``."""
     haystack = " ".join(texts).lower()
     return all(word in haystack for word in needle.lower().split())
+
+
+ELLIPSIS = "…"
+SHORTEST = 8  # a column is cut to no fewer cells: below that, the list scrolls sideways (Left/Right)
+
+
+def shorten(text: str, width: int, type_name: bool = False) -> str:
+    """``text`` in at most ``width`` characters: a type first without its ``msg/`` (``std_msgs/String``,
+    which ros2 takes too), then without its middle (``/robot1/cont…_server``), so that both ends stay."""
+    if len(text) <= width:
+        return text
+    if type_name:
+        text = re.sub(r"/(msg|srv|action)/", "/", text)
+        if len(text) <= width:
+            return text
+    head = width // 2
+    return text[:head] + ELLIPSIS + text[len(text) - (width - head - 1):] if width > 1 else text[:width]
+
+
+def cut_widths(room: int, widths: list[int]) -> int | None:
+    """The one width to cut the widest of columns ``widths`` wide to, so that they fit ``room`` together
+    (the narrower ones kept whole); None when they fit uncut."""
+    if sum(widths) <= room:
+        return None
+    kept = 0
+    for index, width in enumerate(sorted(widths)):
+        left = len(widths) - index  # the columns this width and wider
+        if kept + width * left > room:
+            return max(SHORTEST, (room - kept) // left)
+        kept += width
+    return None
 
 
 def shown_endpoints(endpoints: dict[str, Any]) -> dict[str, Any]:

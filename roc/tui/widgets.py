@@ -15,7 +15,7 @@ from textual.widgets import DataTable, Input, Static
 from textual.widgets.data_table import ColumnKey
 
 from roc.tui.feed import Feed
-from roc.tui.model import Row, matches
+from roc.tui.model import Row, cut_widths, matches, shorten
 from roc.tui.problems import NO_PUBLISHER
 
 
@@ -47,6 +47,7 @@ def severity(problems: list[str]) -> str:
 
 STYLES = {"error": "bold red", "warning": "yellow", "": ""}
 MARKS = {"error": "!! ", "warning": "!  ", "": "   "}  # still seen without colour (NO_COLOR)
+MARKS_WIDTH = 2
 
 
 class ListTable(DataTable):
@@ -67,12 +68,16 @@ class ListTable(DataTable):
     """
 
     def __init__(self, columns: tuple[str, ...], marks: bool = False, widths: dict[str, int] | None = None,
-                 **options) -> None:
+                 cut_columns: tuple[str, ...] = (), **options) -> None:
         """``widths``: columns of a fixed width, for values that change all the time (rates): a
-        column sized to its content is measured again, row by row, whenever a cell outgrows it."""
+        column sized to its content is measured again, row by row, whenever a cell outgrows it.
+        ``cut_columns``: columns of names (or ``type``) shortened (roc.tui.model.shorten) so that every
+        column fits the table's width: none is pushed out of sight."""
         super().__init__(cursor_type="row", zebra_stripes=False, **options)
         self.columns_names = columns
         self.widths = widths or {}
+        self.cut_columns = cut_columns
+        self.cut: int | None = None  # the width the cut_columns' cells are cut to (None: whole)
         self.marks = marks  # a first column of marks for rows with problems
         self.filter = ""
         self.rows_by_key: dict[str, Row] = {}
@@ -81,7 +86,7 @@ class ListTable(DataTable):
 
     def on_mount(self) -> None:
         if self.marks:
-            self.add_column("", key="!", width=2)
+            self.add_column("", key="!", width=MARKS_WIDTH)
         for name in self.columns_names:
             self.add_column(name, key=name, width=self.widths.get(name))
 
@@ -103,9 +108,28 @@ class ListTable(DataTable):
             self._update_count += 1  # part of the key of DataTable's row and line caches
             self.refresh()
 
+    def on_resize(self, _event) -> None:
+        if self._all:
+            self.show(self._all)
+
+    def fit(self, rows: list[Row]) -> int | None:
+        """The width the ``cut_columns`` are cut to so that every column of ``rows`` fits the table."""
+        if not self.cut_columns or not self.size.width:  # not laid out (a hidden tab): as it was
+            return self.cut
+        natural = {name: max([len(name), *(len(row.cells[index]) for row in rows)])
+                   for index, name in enumerate(self.columns_names)}
+        fixed = sum(self.widths.get(name, width) for name, width in natural.items() if name not in self.cut_columns)
+        padding = 2 * self.cell_padding * (len(self.columns_names) + self.marks)
+        room = (self.size.width - self.styles.scrollbar_size_vertical - padding - fixed
+                - (MARKS_WIDTH if self.marks else 0))
+        return cut_widths(room, [natural[name] for name in self.cut_columns])
+
     def _cells(self, row: Row) -> list:
         style = STYLES[severity(row.problems)]
-        cells: list = [Text(cell, style=style) for cell in row.cells]  # never Rich markup: "[1, 2]" is a value
+        texts = row.cells if self.cut is None else [
+            shorten(cell, self.cut, name == "type") if name in self.cut_columns else cell
+            for name, cell in zip(self.columns_names, row.cells)]
+        cells: list = [Text(cell, style=style) for cell in texts]  # never Rich markup: "[1, 2]" is a value
         if self.marks:
             cells.insert(0, Text(MARKS[severity(row.problems)].strip(), style=style))
         return cells
@@ -120,6 +144,13 @@ class ListTable(DataTable):
             self.call_after_refresh(lambda: self.show(self._all))
         keys = [r.key for r in shown]
         current = self.selected_key()
+        cut = self.fit(shown)
+        if cut != self.cut:  # every row drawn again, its columns measured anew
+            self.cut = cut
+            self.clear()
+            self._shown, self.rows_by_key = [], {}
+            for name in self.cut_columns:
+                self.columns[ColumnKey(name)].content_width = len(name)
         if keys[:len(self._shown)] != self._shown:  # rows gone or moved: all drawn again
             self.clear()
             self._shown, self.rows_by_key = [], {}

@@ -4,8 +4,10 @@ a key that acts on a row acting on the row the cursor is on."""
 from __future__ import annotations
 
 import asyncio
+import re
 
-from helpers.tui import DataFeed, launch_rows, screen_name, table, until
+import pytest
+from helpers.tui import DataFeed, launch_rows, screen_lines, screen_name, table, until
 
 from roc.tui.app import RocApp
 from roc.tui.model import Row
@@ -103,3 +105,51 @@ def test_the_palette_lists_a_command_without_unrelated_names() -> None:
             assert sorted(await palette_entries(app, pilot, "set_logger")) == [
                 "service /listener/set_logger_levels", "service /talker/set_logger_levels"]
     asyncio.run(test())
+
+
+LONG_NAMES = {
+    "nodes": [{"name": name, "namespace": "/warehouse/robot_17", "full_name": f"/warehouse/robot_17/{name}"}
+              for name in ("navigation_controller_server", "behavior_tree_navigator", "talker")],
+    "topics": [{"name": name, "types": [type_name], "publishers": 1, "subscribers": 1}
+               for name, type_name in (("/warehouse/robot_17/local_costmap/published_footprint",
+                                        "geometry_msgs/msg/PolygonStamped"),
+                                       ("/chatter", "std_msgs/msg/String"), ("/parameter_events",
+                                                                            "rcl_interfaces/msg/ParameterEvent"))],
+    "services": [], "actions": []}
+
+
+@pytest.mark.parametrize("size", [(120, 35), (170, 35), (80, 24)])
+def test_the_first_screen_shows_every_column_the_manual_promises(size: tuple[int, int]) -> None:
+    """Long names are cut in the middle, types first without their msg/, so that the memory and type
+    columns stay on the screen (mem was out of sight at 120 and 170 columns, the type cut at
+    std_msgs/msg/Str)."""
+    async def test() -> None:
+        app = RocApp(feed=DataFeed(LONG_NAMES))
+        async with app.run_test(size=size) as pilot:
+            await until(pilot, lambda: len(table(app, "#topics-table").rows_by_key) == 3
+                        and len(table(app, "#nodes-table").rows_by_key) == 3, what="the lists")
+            await pilot.pause(0.3)
+            lines = screen_lines(app)
+            screen = "\n".join(lines)
+            headers = [line for line in lines if " node " in line or " topic " in line]
+            for column in ("node", "cpu", "mem", "topic", "pub", "sub", "rate", "bandwidth", "type"):
+                assert any(re.search(rf"\b{column}\b", line) for line in headers), f"{column}:\n{screen}"
+            chatter = next(line for line in lines if "/chatter" in line)
+            assert re.search(r"std_msgs/(msg/)?String\b", chatter), screen
+            assert "/wareh" in screen and "…" in screen  # a long name with its ends
+            assert table(app, "#nodes-table").rows_by_key["/warehouse/robot_17/talker"].cells[0] \
+                == "/warehouse/robot_17/talker"  # the rows keep the whole name (the filter, Enter)
+    asyncio.run(test())
+
+
+def test_names_are_cut_in_the_middle_and_types_first_lose_their_msg() -> None:
+    from roc.tui.model import cut_widths, shorten
+
+    assert shorten("/warehouse/robot_17/talker", 12) == "/wareh…alker"
+    assert shorten("std_msgs/msg/String", 16, type_name=True) == "std_msgs/String"
+    assert shorten("geometry_msgs/msg/PolygonStamped", 16, type_name=True) == "geometry…Stamped"
+    assert shorten("/chatter", 12) == "/chatter"
+    assert cut_widths(40, [10, 20]) is None  # they fit
+    assert cut_widths(40, [10, 50]) == 30  # the narrow one kept whole
+    assert cut_widths(40, [30, 50]) == 20
+    assert cut_widths(10, [30, 50]) == 8  # never narrower: the list scrolls sideways then
