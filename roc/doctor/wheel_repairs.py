@@ -97,11 +97,16 @@ def repair_rosidl_py_export(text: str, python: Interpreter) -> str:
     if python.numpy_include:  # numpy first: its pattern is more specific than the Python include one
         text = _NUMPY_INCLUDE_RE.sub(lambda _m: python.numpy_include or "", text)
     text = _PY_INCLUDE_RE.sub(lambda _m: python.include, text)
-    if python.libpython and "INTERFACE_LINK_LIBRARIES" not in text:
-        # the library's own dependency on libpython, listed after it on every link line that has it
-        text = re.sub(r"^(  INTERFACE_INCLUDE_DIRECTORIES .*)$",
-                      lambda m: f'{m.group(1)}\n  INTERFACE_LINK_LIBRARIES "{python.libpython}"',
-                      text, count=1, flags=re.MULTILINE)
+    if python.libpython:
+        # The library's own dependency on libpython, after it on every link line that has it. Linked
+        # whatever --as-needed says (Debian's and Ubuntu's default): the program itself uses no CPython
+        # symbol, and ld then drops libpython and fails on the library's undefined ones.
+        wanted = f'  INTERFACE_LINK_LIBRARIES "-Wl,--no-as-needed;{python.libpython};-Wl,--as-needed"'
+        if "INTERFACE_LINK_LIBRARIES" in text:  # the wheels list none here: a line of an earlier repair
+            text = re.sub(r"^  INTERFACE_LINK_LIBRARIES .*$", lambda _m: wanted, text, count=1, flags=re.MULTILINE)
+        else:
+            text = re.sub(r"^(  INTERFACE_INCLUDE_DIRECTORIES .*)$", lambda m: f"{m.group(1)}\n{wanted}",
+                          text, count=1, flags=re.MULTILINE)
     return text
 
 

@@ -70,8 +70,19 @@ def test_a_generator_py_library_gets_this_pythons_includes_and_libpython_in_its_
     wheel_repairs.apply(wheel_repairs.planned(prefix, PYTHON))
     text = (prefix / "share/std_msgs/cmake/export_std_msgs__rosidl_generator_pyExport.cmake").read_text()
     assert ('  INTERFACE_INCLUDE_DIRECTORIES "/usr/include/python3.11;/venv/site-packages/numpy/_core/include"\n'
-            '  INTERFACE_LINK_LIBRARIES "/usr/lib/x86_64-linux-gnu/libpython3.11.so"\n)') in text
+            '  INTERFACE_LINK_LIBRARIES "-Wl,--no-as-needed;/usr/lib/x86_64-linux-gnu/libpython3.11.so;-Wl,--as-needed"'
+            '\n)') in text
     assert "/opt/python" not in text
+
+
+def test_a_libpython_of_another_python_is_replaced_by_this_ones(tmp_path):
+    prefix = wheel_prefix(tmp_path)
+    other = Interpreter(PYTHON.include, PYTHON.numpy_include, libpython="/opt/old/lib/libpython3.11.so")
+    wheel_repairs.apply(wheel_repairs.planned(prefix, other))
+    wheel_repairs.apply(wheel_repairs.planned(prefix, PYTHON))
+    text = (prefix / "share/std_msgs/cmake/export_std_msgs__rosidl_generator_pyExport.cmake").read_text()
+    assert text.count("INTERFACE_LINK_LIBRARIES") == 1 and "/opt/old" not in text
+    assert wheel_repairs.planned(prefix, PYTHON) == []
 
 
 def test_without_a_shared_libpython_only_the_include_paths_are_repaired(tmp_path):
