@@ -164,11 +164,28 @@ def counts(snapshot: dict[str, Any], hidden: bool = False) -> dict[str, int]:
     return {kind: len(visible(snapshot[kind], hidden)) for kind in ("nodes", "topics", "services", "actions")}
 
 
+def duration_text(ns: int | None) -> str:
+    return "Infinite" if ns is None else f"{ns / 1e6:g} ms"  # ros2 topic info -v's word for none
+
+
 def endpoint_cells(endpoint: dict[str, Any]) -> tuple[str, ...]:
     """An endpoint as a row: node, side, reliability, durability, history (depth), deadline."""
     qos = endpoint["qos"]
     history = f"KEEP_LAST ({qos['depth']})" if qos["history"] == "KEEP_LAST" else qos["history"]
-    deadline = "-" if qos["deadline_ns"] is None else f"{qos['deadline_ns'] / 1e6:g} ms"
     who = f"{endpoint['node_namespace'].rstrip('/')}/{endpoint['node_name']}"
     side = "publisher" if endpoint["endpoint_type"] == "PUBLISHER" else "subscriber"
-    return who, side, qos["reliability"], qos["durability"], history, deadline
+    return who, side, qos["reliability"], qos["durability"], history, duration_text(qos["deadline_ns"])
+
+
+# why an endpoint's history is UNKNOWN (rmw's RMW_QOS_POLICY_HISTORY_UNKNOWN, depth 0)
+UNKNOWN_HISTORY = "history (depth) UNKNOWN: DDS discovery does not carry them; ros2 topic info -v says UNKNOWN too"
+
+
+def endpoint_detail(endpoint: dict[str, Any]) -> str:
+    """The rest of ros2 topic info -v's QoS profile of an endpoint, and why its history may be unknown."""
+    qos = endpoint["qos"]
+    lines = [f"lifespan {duration_text(qos['lifespan_ns'])}, liveliness {qos['liveliness']} (lease "
+             f"{duration_text(qos['liveliness_lease_duration_ns'])}), GID {endpoint['gid']}"]
+    if qos["history"] == "UNKNOWN":
+        lines.append(UNKNOWN_HISTORY)
+    return "\n".join(lines)

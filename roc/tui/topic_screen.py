@@ -1,6 +1,6 @@
-"""A topic: its endpoints with their QoS and the problems between them, its rate and bandwidth (as
-``roc topic hz`` and ``bw`` measure them), and a live echo of its latest message: ``p`` pauses it,
-``f`` shows one field, ``i`` draws an image topic."""
+"""A topic: its endpoints with their QoS (the one under the cursor's in full, as ros2 topic info -v) and
+the problems between them, its rate and bandwidth (as ``roc topic hz`` and ``bw`` measure them), and a
+live echo of its latest message: ``p`` pauses it, ``f`` shows one field, ``i`` draws an image topic."""
 
 from __future__ import annotations
 
@@ -13,13 +13,21 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import VerticalScroll
 from textual.screen import Screen
-from textual.widgets import Footer, Static
+from textual.widgets import DataTable, Footer, Static
 from textual.worker import get_current_worker
 
 from roc.cli.options import DEFAULT_TRUNCATE_LENGTH
 from roc.errors import RocError
 from roc.ros.rates import Sample, Window
-from roc.tui.model import TOPIC_WINDOW, Row, bandwidth_text, endpoint_cells, rate_text, shown_endpoints
+from roc.tui.model import (
+    TOPIC_WINDOW,
+    Row,
+    bandwidth_text,
+    endpoint_cells,
+    endpoint_detail,
+    rate_text,
+    shown_endpoints,
+)
 from roc.tui.problems import topic_diagnoses
 from roc.tui.widgets import ListTable, Prompt, host
 
@@ -52,6 +60,7 @@ class TopicScreen(Screen):
     DEFAULT_CSS = """
     TopicScreen #title { height: 1; background: $primary; }
     TopicScreen #endpoints { height: auto; max-height: 8; }
+    TopicScreen #qos { height: auto; color: $text-muted; }
     TopicScreen #problems { height: auto; color: $error; }
     TopicScreen #stats { height: auto; }
     TopicScreen #echo-title { height: 1; background: $boost; }
@@ -69,10 +78,13 @@ class TopicScreen(Screen):
         self.drawn = -1  # its number
         self.paused = False
         self.field = ""
+        self.endpoints: dict[str, dict[str, Any]] = {}  # gid -> the endpoint (roc.ros.graph's dict)
 
     def compose(self) -> ComposeResult:
         yield Static(Text(f"topic {self.topic}", style="bold"), id="title")
-        yield ListTable(("node", "side", "reliability", "durability", "history", "deadline"), id="endpoints")
+        yield ListTable(("node", "side", "reliability", "durability", "history", "deadline"), id="endpoints",
+                        cut_columns=("node",))
+        yield Static("", id="qos")
         yield Static("", id="problems")
         yield Static("rate: subscribing...", id="stats")
         yield Static("", id="echo-title")
@@ -99,13 +111,23 @@ class TopicScreen(Screen):
 
     def show_endpoints(self, info: dict[str, Any]) -> None:
         info = {**info, **shown_endpoints(info)}
-        rows = [Row(endpoint["gid"], endpoint_cells(endpoint)) for endpoint in info["publishers"] + info["subscribers"]]
-        self.query_one("#endpoints", ListTable).show(rows)
+        self.endpoints = {endpoint["gid"]: endpoint for endpoint in info["publishers"] + info["subscribers"]}
+        self.query_one("#endpoints", ListTable).show(
+            [Row(gid, endpoint_cells(endpoint)) for gid, endpoint in self.endpoints.items()])
+        self.show_qos()
         problems = topic_diagnoses({**info, "publishers": len(info["publishers"]),
                                     "subscribers": len(info["subscribers"]), "endpoints": info})
         self.query_one("#problems", Static).update(Text("\n".join(f"! {p}" for p in problems)))
         self.type_name = self.type_name or (info["types"][0] if info["types"] else None)
         self.query_one("#title", Static).update(Text(f"topic {self.topic}  {', '.join(info['types'])}", style="bold"))
+
+    def show_qos(self) -> None:
+        """Under the endpoints, the rest of the QoS of the one under the cursor."""
+        endpoint = self.endpoints.get(self.query_one("#endpoints", ListTable).selected_key() or "")
+        self.query_one("#qos", Static).update(Text(endpoint_detail(endpoint) if endpoint else ""))
+
+    def on_data_table_row_highlighted(self, _event: DataTable.RowHighlighted) -> None:
+        self.show_qos()
 
     @work(thread=True, exclusive=True, group="echo")
     def echo(self) -> None:

@@ -7,7 +7,7 @@ import asyncio
 import re
 
 import pytest
-from helpers.tui import DataFeed, launch_rows, screen_lines, screen_name, table, until
+from helpers.tui import DataFeed, launch_rows, screen_lines, screen_name, table, text_of, until
 
 from roc.tui.app import RocApp
 from roc.tui.model import Row
@@ -153,3 +153,36 @@ def test_names_are_cut_in_the_middle_and_types_first_lose_their_msg() -> None:
     assert cut_widths(40, [10, 50]) == 30  # the narrow one kept whole
     assert cut_widths(40, [30, 50]) == 20
     assert cut_widths(10, [30, 50]) == 8  # never narrower: the list scrolls sideways then
+
+
+def chatter_endpoint(node: str, side: str, history: str, depth: int) -> dict:
+    return {"node_name": node, "node_namespace": "/", "topic_type": "std_msgs/msg/String", "topic_type_hash": "h",
+            "endpoint_type": side, "gid": f"01.0f.{node}", "qos": {
+                "reliability": "RELIABLE", "history": history, "depth": depth, "durability": "VOLATILE",
+                "lifespan_ns": None, "deadline_ns": 250_000_000, "liveliness": "AUTOMATIC",
+                "liveliness_lease_duration_ns": None}}
+
+
+def test_the_topic_screen_shows_the_qos_as_ros2_topic_info_v_and_says_why_history_is_unknown() -> None:
+    """Discovered endpoints come with history UNKNOWN and depth 0 (rmw: DDS discovery does not carry
+    them); the screen showed a bare UNKNOWN, and no lifespan nor liveliness."""
+    info = {"types": ["std_msgs/msg/String"],
+            "publishers": [chatter_endpoint("talker", "PUBLISHER", "UNKNOWN", 0)],
+            "subscribers": [chatter_endpoint("listener", "SUBSCRIPTION", "KEEP_LAST", 7)]}
+
+    async def test() -> None:
+        app = RocApp(feed=DataFeed(EMPTY, {"topic_endpoints": info}))
+        async with app.run_test(size=(80, 24)) as pilot:
+            app.open("topic", "/chatter")
+            await until(pilot, lambda: screen_name(app) == "TopicScreen" and bool(app.screen.query("#endpoints"))
+                        and len(table(app, "#endpoints").rows_by_key) == 2, what="the endpoints")
+            rows = {row.cells[0]: row.cells for row in table(app, "#endpoints").rows_by_key.values()}
+            assert rows["/talker"][4:] == ("UNKNOWN", "250 ms") and rows["/listener"][4] == "KEEP_LAST (7)"
+            table(app, "#endpoints").select("01.0f.talker")
+            await until(pilot, lambda: "DDS discovery does not carry" in text_of(app, "#qos"), what="why")
+            assert "ros2 topic info -v says UNKNOWN too" in text_of(app, "#qos")
+            assert "lifespan Infinite, liveliness AUTOMATIC (lease Infinite), GID 01.0f.talker" in text_of(app, "#qos")
+            table(app, "#endpoints").select("01.0f.listener")
+            await until(pilot, lambda: "GID 01.0f.listener" in text_of(app, "#qos"), what="the listener's QoS")
+            assert "UNKNOWN" not in text_of(app, "#qos")
+    asyncio.run(test())
