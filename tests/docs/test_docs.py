@@ -23,7 +23,6 @@ from helpers.docs_examples import (
     split_at_interrupt,
     unchecked_output_blocks,
 )
-from helpers.oracles import SHARED, require_oracle
 
 from roc.cli.commands import build_parser
 
@@ -172,9 +171,6 @@ def test_every_console_block_that_shows_output_is_run_or_says_why_not() -> None:
 
 @pytest.mark.parametrize("sequence", _all_sequences())
 def test_the_examples_print_what_the_page_shows(sequence: Sequence, tmp_path: Path) -> None:
-    if sequence.directory == "workspaces/example" and importlib.util.find_spec("launch") is None:
-        # demo_py depends on launch, which scripts/setup.sh installs from ../shared (without it roc warns)
-        require_oracle("the launch library's installer", SHARED / "oracles" / "install_launch.sh")
     directory = tmp_path / "example"
     shutil.copytree(REPO / sequence.directory, directory, symlinks=True,
                     ignore=shutil.ignore_patterns("build", "install", "log", "__pycache__"))

@@ -29,6 +29,30 @@ def example(example_workspace):
     return example_workspace
 
 
+def _packages_from_pypi() -> set[str]:
+    """The ROS packages of this venv that came from PyPI's wheels: in the files of a distribution installed
+    from an index (pip writes direct_url.json for one installed from a path, as the launch system of
+    ../shared is; composition_interfaces, built with CMake there, belongs to no distribution)."""
+    from importlib import metadata
+
+    index = "share/ament_index/resource_index/packages/"
+    return {str(file).rsplit("/", 1)[1] for distribution in metadata.distributions()
+            if distribution.read_text("direct_url.json") is None
+            for file in distribution.files or [] if index in str(file)}
+
+
+def test_the_example_needs_only_what_the_set_up_takes_from_pypi():
+    """The README's quick start builds the example on a fresh clone, where ../shared, and with it the
+    launch system, may be missing: a dependency from there was a warning on the quick start's first
+    build (demo_py's exec_depend on launch and launch_ros, for a launch file nothing used)."""
+    from roc.workspace.load import discover_workspace
+    from roc.workspace.underlay import missing_dependencies
+
+    packages = discover_workspace(REPO / "workspaces" / "example")
+    known = {package.name for package in packages} | _packages_from_pypi()
+    assert "rclpy" in known and missing_dependencies(packages, known, ("build", "run")) == {}
+
+
 @pytest.mark.distro
 def test_cpp_executables_and_interfaces(example):
     ran = in_sourced_shell(example, "install/demo_tools/lib/demo_tools/filter_demo; demo_plain; "
