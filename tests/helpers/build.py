@@ -123,10 +123,16 @@ def sourced_values(workspace: Path, setup: str = "install/setup.bash", strict: b
 def without_own_underlay(values: dict[str, str]) -> dict[str, str]:
     """roc's sourced values less the entries of the venv's ROS 2, the underlay these tests build on:
     roc's setup scripts chain it and colcon's cannot (it has no local_setup script, see
-    roc/environment/chain.py). PATH keeps it: the clean shell starts with the venv's bin."""
+    roc/environment/chain.py), the wheels' library folders included. PATH keeps it: the clean shell starts
+    with the venv's bin."""
+    from roc.environment.chain import wheel_library_operations
+
     assert values["AMENT_PREFIX_PATH"].split(os.pathsep)[-1] == sys.prefix, values["AMENT_PREFIX_PATH"]
+    # the wheels' library folders outside the venv (the interpreter's libpython folder) are the venv's too
+    libraries = {os.path.join(sys.prefix, op.values[0]) for op in wheel_library_operations(Path(sys.prefix))}
+
     def ours(entry: str) -> bool:
-        return entry == sys.prefix or entry.startswith(sys.prefix + os.sep)
+        return entry == sys.prefix or entry.startswith(sys.prefix + os.sep) or entry in libraries
 
     return {name: os.pathsep.join(e for e in value.split(os.pathsep) if name == "PATH" or not ours(e))
             for name, value in values.items()}
