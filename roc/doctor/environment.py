@@ -12,8 +12,9 @@ from pathlib import Path
 
 from roc import distribution as ros_distribution
 from roc.ament_index import resources
+from roc.doctor import wheel_repairs
 from roc.doctor.findings import Finding
-from roc.environment import ament_prefixes, path_list
+from roc.environment import ament_prefixes, own_prefix, path_list
 
 CATEGORY = "environment"
 DEFAULT_RMW = "rmw_fastrtps_cpp"
@@ -147,8 +148,24 @@ def overlays(env: Mapping[str, str]) -> list[Finding]:
     return findings
 
 
+def wheels(repairs: list[wheel_repairs.Repair] | None = None) -> Finding:
+    """Whether ROS 2 installed from PyPI wheels into roc's own environment needs the repairs without which
+    ament_cmake builds and C++ programs fail (roc.doctor.wheel_repairs); ``roc doctor --fix`` applies them."""
+    prefix = own_prefix()
+    if prefix is None:
+        return Finding(CATEGORY, "ros wheels", "ok", "no ROS 2 wheels in roc's environment")
+    if repairs is None:
+        repairs = wheel_repairs.planned(prefix, wheel_repairs.this_interpreter())
+    if not repairs:
+        return Finding(CATEGORY, "ros wheels", "ok", f"the ROS 2 wheels in {prefix} need no repair")
+    reasons = sorted({repair.why for repair in repairs})
+    return Finding(CATEGORY, "ros wheels", "warning",
+                   f"{len(repairs)} CMake file(s) of the ROS 2 wheels in {prefix} break builds: " + "; ".join(reasons),
+                   "roc doctor --fix", details={"files": [str(repair.path) for repair in repairs]})
+
+
 def checks(env: Mapping[str, str] = os.environ) -> list[Finding]:
-    return [distribution(env), middleware(env), domain(env), *discovery(env), *overlays(env)]
+    return [distribution(env), middleware(env), domain(env), *discovery(env), *overlays(env), wheels()]
 
 
 def reports(env: Mapping[str, str] = os.environ) -> dict[str, list[tuple[str, str]]]:

@@ -102,3 +102,22 @@ def test_tracetools_keeps_lttng_ust_where_the_library_is_installed_under_its_nam
 
 def test_an_installation_without_the_wheels_files_needs_no_repair(tmp_path):
     assert wheel_repairs.planned(tmp_path, PYTHON) == []
+
+
+def test_doctor_reports_the_repairs_and_fix_applies_them(tmp_path, monkeypatch):
+    import roc.environment
+    from roc.commands.doctor import check
+    from roc.doctor import environment
+
+    prefix = wheel_prefix(tmp_path)
+    monkeypatch.setattr(roc.environment, "own_prefix", lambda: prefix)
+    monkeypatch.setattr(environment, "own_prefix", lambda: prefix)
+    monkeypatch.setattr(wheel_repairs, "this_interpreter", lambda: PYTHON)
+    finding = environment.wheels()
+    assert (finding.level, finding.fix) == ("warning", "roc doctor --fix")
+    assert finding.message.startswith(f"4 CMake file(s) of the ROS 2 wheels in {prefix} break builds: ")
+    assert "links lttng-ust, which the wheel ships only under another name" in finding.message
+    fixed = check._fix()
+    assert len(fixed) == 4 and all(line.startswith(f"fixed {prefix}/share/") for line in fixed)
+    assert environment.wheels().level == "ok"
+    assert check._fix() == ["nothing to fix"]

@@ -27,6 +27,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--exclude-packages", "-ep", action="store_true",
                         help="accepted for ros2's sake: roc does not compare package versions with rosdistro")
     parser.add_argument("--include-warnings", "-iw", action="store_true", help="count warnings as failed checks")
+    parser.add_argument("--fix", action="store_true",
+                        help="first apply the repairs that are safe (the CMake files of ROS 2's PyPI wheels in "
+                             "roc's environment) and say what changed")
     add_graph_arguments(parser)
 
 
@@ -63,7 +66,19 @@ def _finding_lines(findings: list[Finding]) -> list[str]:
     return lines
 
 
+def _fix() -> list[str]:
+    """Apply the safe repairs; one line per changed file."""
+    from roc.doctor import wheel_repairs
+    from roc.environment import own_prefix
+
+    prefix = own_prefix()
+    repairs = wheel_repairs.planned(prefix, wheel_repairs.this_interpreter()) if prefix else []
+    wheel_repairs.apply(repairs)
+    return [f"fixed {repair.path}: {repair.why}" for repair in repairs] or ["nothing to fix"]
+
+
 def run(args: argparse.Namespace) -> int:
+    fixed = _fix() if args.fix else []
     findings = environment.checks()
     findings += network.checks(discovery_range(os.environ))
     graph_findings, asked = _graph(args)
@@ -79,14 +94,14 @@ def run(args: argparse.Namespace) -> int:
     if args.report:
         lines = [line for name, items in reports.items() for line in report_lines(name, items)]
     else:
-        lines = _finding_lines(findings) + [""]
+        lines = [*fixed, *([""] if fixed else []), *_finding_lines(findings), ""]
         if result["failed"]:
             lines += [f"{result['failed']}/{result['checks']} check(s) failed", "",
                       "Failed modules: " + " ".join(result["failed_categories"])]
         else:
             lines.append(f"All {result['checks']} checks passed")
         lines += [line for name, items in reports.items() for line in report_lines(name, items)]
-    data = {"findings": [f.as_dict() for f in findings], **result,
+    data = {**({"fixed": fixed} if args.fix else {}), "findings": [f.as_dict() for f in findings], **result,
             **({"reports": {name: [{"item": k, "value": v} for k, v in items] for name, items in reports.items()}}
                if reports else {})}
     render(data, args.format, lines)
