@@ -3,23 +3,37 @@
 from __future__ import annotations
 
 import os
+import sys
 import tempfile
 from pathlib import Path
+from types import ModuleType
 
 from roc.errors import RocError
+
+
+def protoc_module() -> ModuleType:
+    """grpcio-tools' protoc. grpcio-tools is roc's idl extra, not a dependency: it needs setuptools>=77,
+    which colcon and ROS's Python packages do not take. Missing, a one-line RocError says how to install it."""
+    try:
+        from grpc_tools import protoc
+    except ImportError:
+        raise RocError("protoc is not installed: roc idl and .proto sources need grpcio-tools (roc's idl extra): "
+                       f"{sys.executable} -m pip install grpcio-tools (pipx: pipx inject roc-ros2 grpcio-tools)") \
+            from None
+    return protoc
 
 
 def well_known_include() -> str:
     """The directory holding google/protobuf/*.proto, bundled with grpcio-tools."""
     from importlib import resources
 
+    protoc_module()
     return str(resources.files("grpc_tools") / "_proto")
 
 
 def run(arguments: list[str]) -> tuple[int, str]:
     """Run protoc with ``arguments``; its exit code and what it printed (it writes to fd 2 directly)."""
-    from grpc_tools import protoc
-
+    protoc = protoc_module()
     with tempfile.TemporaryFile(mode="w+") as captured:
         saved = os.dup(2)
         os.dup2(captured.fileno(), 2)
