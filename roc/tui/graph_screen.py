@@ -37,7 +37,9 @@ LISTS = {
     "actions": (("action", "type"), False, ("action", "type")),
 }
 SYSTEM = ("nodes", "topics")
-NARROW = 100  # below this many columns, the nodes are above the topics instead of beside them
+# below this many columns, the nodes are above the topics instead of beside them: beside them, the topics'
+# names and types would get some 10 columns each
+NARROW = 120
 
 
 class ListTabs(TabbedContent):

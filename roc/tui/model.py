@@ -178,7 +178,7 @@ def endpoint_cells(endpoint: dict[str, Any]) -> tuple[str, ...]:
 
 
 # why an endpoint's history is UNKNOWN (rmw's RMW_QOS_POLICY_HISTORY_UNKNOWN, depth 0)
-UNKNOWN_HISTORY = "history (depth) UNKNOWN: DDS discovery does not carry them; ros2 topic info -v says UNKNOWN too"
+UNKNOWN_HISTORY = "history (depth) UNKNOWN: not carried by DDS discovery; ros2 topic info -v: same"
 
 
 def endpoint_detail(endpoint: dict[str, Any]) -> str:

@@ -82,6 +82,7 @@ class ListTable(DataTable):
         self.filter = ""
         self.rows_by_key: dict[str, Row] = {}
         self._all: list[Row] = []
+        self._showing = False
         self._shown: list[str] = []
 
     def on_mount(self) -> None:
@@ -136,6 +137,17 @@ class ListTable(DataTable):
 
     def show(self, rows: Iterable[Row]) -> None:
         self._all = list(rows)
+        if self._showing:  # asked again while drawing (clear() scrolls to the top, and a screen may watch
+            # that): drawn once this is done, not twice over (the rows added twice: DuplicateKey)
+            self.call_after_refresh(lambda: self.show(self._all))
+            return
+        self._showing = True
+        try:
+            self._show()
+        finally:
+            self._showing = False
+
+    def _show(self) -> None:
         shown = [r for r in self._all if not self.filter or matches(self.filter, *r.cells)]
         if not self._shown and len(shown) > self.app.size.height:
             # the first fill: the rows a screen can show now (a first paint of 200 topics costs their

@@ -179,8 +179,8 @@ def test_the_topic_screen_shows_the_qos_as_ros2_topic_info_v_and_says_why_histor
             rows = {row.cells[0]: row.cells for row in table(app, "#endpoints").rows_by_key.values()}
             assert rows["/talker"][4:] == ("UNKNOWN", "250 ms") and rows["/listener"][4] == "KEEP_LAST (7)"
             table(app, "#endpoints").select("01.0f.talker")
-            await until(pilot, lambda: "DDS discovery does not carry" in text_of(app, "#qos"), what="why")
-            assert "ros2 topic info -v says UNKNOWN too" in text_of(app, "#qos")
+            await until(pilot, lambda: "not carried by DDS discovery" in text_of(app, "#qos"), what="why")
+            assert "ros2 topic info -v: same" in text_of(app, "#qos")
             assert "lifespan Infinite, liveliness AUTOMATIC (lease Infinite), GID 01.0f.talker" in text_of(app, "#qos")
             table(app, "#endpoints").select("01.0f.listener")
             await until(pilot, lambda: "GID 01.0f.listener" in text_of(app, "#qos"), what="the listener's QoS")

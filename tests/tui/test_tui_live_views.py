@@ -56,7 +56,7 @@ def test_nodes_and_topics_side_by_side_with_cpu_rates_and_only_real_problems(gra
 
     async def test() -> None:
         app = RocApp(checks=load_checks(tmp_path / "roc.toml"))
-        async with app.run_test(size=(100, 30)) as pilot:
+        async with app.run_test(size=(120, 35)) as pilot:
             nodes, topics = (lambda: table(app, "#nodes-table").rows_by_key), (lambda: table(app, "#topics-table").rows_by_key)
             await until(pilot, lambda: {"/talker", "/mortal", "/poser", "/managed"} <= set(nodes())
                         and topics().get("/chatter") and topics()["/chatter"].cells[3].endswith("Hz")

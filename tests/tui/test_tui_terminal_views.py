@@ -1,5 +1,5 @@
-"""roc tui's views in a real terminal (tmux at 100x30 and 80x24), keys typed and the screen read: the
-first screen (nodes beside the topics, or above them when narrow), the help (``?``), the palette
+"""roc tui's views in a real terminal (tmux at 120x35 and 80x24), keys typed and the screen read: the
+first screen (nodes beside the topics, or above them when narrow; every column in sight), the help (``?``), the palette
 (``:``), the logs, a plot and the diagnostics, each within the terminal's lines and columns."""
 
 from __future__ import annotations
@@ -11,6 +11,8 @@ import pytest
 from helpers.build import BIN
 from helpers.graph import graph_env, start_nodes, stop_all
 from helpers.tui import GRAPH, Terminal, live_graph, require_tmux, start_tui_nodes
+
+from roc.tui.graph_screen import NARROW
 
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("tui_terminal_views")]
 require_tmux()
@@ -51,7 +53,7 @@ def back(terminal: Terminal) -> None:
     terminal.wait(lambda s: "System" in s and "Services" in s, "the first screen again")
 
 
-@pytest.mark.parametrize("size", [(100, 30), (80, 24)], ids=["100x30", "80x24"])
+@pytest.mark.parametrize("size", [(120, 35), (80, 24)], ids=["120x35", "80x24"])
 def test_the_views_typed_and_read_in_a_real_terminal(graph, tmp_path: Path, size: tuple[int, int]) -> None:
     terminal = Terminal(tmp_path, [str(BIN / "roc"), "tui", "--no-workspace"], graph, tmp_path, size=size)
     try:
@@ -61,7 +63,10 @@ def test_the_views_typed_and_read_in_a_real_terminal(graph, tmp_path: Path, size
         lines = screen.splitlines()
         assert re.search(r"\b9 nodes\b.*\btopics\b", lines[0]), lines[0]
         side_by_side = any(re.search(r"/chatty_logger\s.*\s/chatter\s", line) for line in lines)
-        assert side_by_side == (size[0] >= 100), screen  # below 100 columns, the nodes above the topics
+        assert side_by_side == (size[0] >= NARROW), screen  # below 120 columns, the nodes above the topics
+        for column in ("node", "cpu", "mem", "topic", "pub", "sub", "rate", "bandwidth", "type"):
+            assert re.search(rf"\b{column}\b", screen), (column, screen)
+        assert re.search(r"/chatter\s.*\sstd_msgs/(msg/)?String\b", screen), screen
 
         terminal.keys("?")
         screen = terminal.wait(lambda s: "keys (Esc: back)" in s, "the help")
