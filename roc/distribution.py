@@ -7,17 +7,21 @@ index has first (AMENT_PREFIX_PATH, then roc's own Python environment: roc.envir
 else ROS_DISTRO. Two distributions in one environment (an overlay built on one, sourced on top of the
 other, chains the first's rclpy in) are a mix (``mix``). roc's build base records the distribution it
 was built with (``MARKER``, ``built_with``), so a workspace built on one distribution is not built
-again on the other. Plain files: no rclpy, nothing imported from ROS."""
+again on the other. A mix is refused before rclpy is loaded (``refuse_mix``, ``guard_rclpy_import``):
+one distribution's rclpy on the other's libraries crashes the process. Plain files: no rclpy, nothing
+imported from ROS."""
 
 from __future__ import annotations
 
 import os
 import re
-from collections.abc import Mapping
+import sys
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 from roc.environment import ament_prefixes
+from roc.errors import RocError
 
 MARKER = ".roc_ros_distribution"  # in a build base roc built in: the distribution's name
 
@@ -111,6 +115,37 @@ def mix(environ: Mapping[str, str] | None = None) -> str | None:
         return None
     first, second = (next(where for name, where in seen if name == n) for n in names[:2])
     return f"{names[0]} ({first}) and {names[1]} ({second})"
+
+
+class MixedDistributions(RocError):
+    """Two ROS 2 distributions are sourced (``mix``)."""
+
+
+def refuse_mix(environ: Mapping[str, str] | None = None) -> None:
+    """Raise MixedDistributions when the environment mixes two distributions."""
+    mixed = mix(environ)
+    if mixed:
+        raise MixedDistributions(f"two ROS 2 distributions are sourced: {mixed}; use a new shell that sources "
+                                 "one of them, and only workspaces built on it")
+
+
+class _RclpyImportGuard:
+    """A finder first on ``sys.meta_path`` that lets rclpy be imported only once ``refuse_mix`` passed: it
+    sees every import of rclpy, whichever module asks (the graph, bags, the bridge, the TUI, launch)."""
+
+    def find_spec(self, name: str, path: Sequence[str] | None = None, target: object = None) -> None:
+        if name == "rclpy":
+            refuse_mix()  # raises before any of rclpy's libraries is loaded
+            sys.meta_path.remove(self)
+        return None  # the ordinary finders find it
+
+
+def guard_rclpy_import() -> None:
+    """Refuse, as a one-line error, every import of rclpy in this process while two distributions are
+    sourced; without it, one's rclpy loaded on the other's libraries fails in C (rcutils errors,
+    std::bad_array_new_length) and the process dies of a segmentation fault."""
+    if "rclpy" not in sys.modules and not any(isinstance(f, _RclpyImportGuard) for f in sys.meta_path):
+        sys.meta_path.insert(0, _RclpyImportGuard())
 
 
 def built_with(build_base: Path) -> str | None:

@@ -33,26 +33,28 @@ def prepare_build_base(build_base: Path) -> None:
         write_text_atomic(build_base / "COLCON_IGNORE", "")
 
 
-def prepare_distribution(build_base: Path, install_base: Path) -> None:
-    """Refuse to build in an environment that sources two ROS 2 distributions, or with another
-    distribution than the one the build base was built with (its CMake caches and the install point at
-    that one's files); then record this one in the build base (roc.distribution)."""
+def check_distribution(build_base: Path, install_base: Path) -> None:
+    """Refuse, before anything is written, to build in an environment that sources two ROS 2
+    distributions, or with another distribution than the one the build base was built with (its CMake
+    caches and the install point at that one's files)."""
     from roc import distribution
 
-    mixed = distribution.mix()
-    if mixed:
-        raise RocError(f"two ROS 2 distributions are sourced: {mixed}; build in a new shell that sources one, "
-                       "and only workspaces built on it")
+    distribution.refuse_mix()
     found = distribution.detected()
-    if found is None:
-        return
-    name, where = found
     built = distribution.built_with(build_base)
-    if built and built != name:
+    if found is not None and built and built != found[0]:
+        name, where = found
         raise RocError(f"'{build_base}' was built with ROS 2 {built}, but the sourced ROS 2 is {name} ({where}): "
                        f"source {built}, or remove '{build_base}' and '{install_base}' to build with {name}")
-    if built != name:
-        write_text_atomic(build_base / distribution.MARKER, name + "\n")
+
+
+def record_distribution(build_base: Path) -> None:
+    """Write the distribution the build base is built with (roc.distribution.MARKER)."""
+    from roc import distribution
+
+    found = distribution.detected()
+    if found is not None and distribution.built_with(build_base) != found[0]:
+        write_text_atomic(build_base / distribution.MARKER, found[0] + "\n")
 
 
 def prepare_install_base(install_base: Path, merged: bool) -> None:

@@ -165,6 +165,9 @@ def spawn_daemon() -> None:
     on Linux (autogroup): on a busy machine the daemon then went without CPU for up to 3.6 s at a
     time, and echo lost 10-35 k of 50 k messages at 5 kHz where it now loses 0-2.5 k
     (bench/dataplane_bench.py)."""
+    from roc.distribution import refuse_mix
+
+    refuse_mix()  # the daemon, started with this environment, would load two distributions' libraries
     path = socket_path()
     with _start_lock(path):
         connection = running_daemon(path)

@@ -1,7 +1,8 @@
 """What one ROS 2 distribution made, used on the other (run in the Kilted suite, where both venvs exist):
 a bag recorded with roc on Jazzy is read and played by roc on Kilted, and the other way round, byte for
-byte; a workspace built on one distribution is refused by roc work build on the other, and so is an
-overlay that sources it over the other (roc doctor says the same)."""
+byte; a workspace built on one distribution is refused by roc work build (and --explain) on the other, and so
+is an overlay that sources it over the other (roc doctor says the same); in a shell that sources both, every
+verb that would load rclpy refuses in one line instead of crashing."""
 
 from __future__ import annotations
 
@@ -116,10 +117,11 @@ def test_a_workspace_built_on_one_distribution_is_refused_on_the_other(tmp_path:
     assert built.returncode == 0, built.stderr
     stamp = (workspace / "install" / "base" / "share" / "base" / "CMakeLists.txt").stat().st_mtime_ns
 
-    again = _run(DISTRO, "work", "build", env=own_env, cwd=workspace)
-    assert again.returncode == 1 and again.stdout == "", again.stdout
-    assert len(again.stderr.splitlines()) == 1, again.stderr
-    assert f"was built with ROS 2 {OTHER}, but the sourced ROS 2 is {DISTRO}" in again.stderr
+    for explain in ((), ("--explain",)):  # --explain answers what the build would
+        again = _run(DISTRO, "work", "build", *explain, env=own_env, cwd=workspace)
+        assert again.returncode == 1 and again.stdout == "", again.stdout
+        assert len(again.stderr.splitlines()) == 1, again.stderr
+        assert f"was built with ROS 2 {OTHER}, but the sourced ROS 2 is {DISTRO}" in again.stderr
     assert (workspace / "install" / "base" / "share" / "base" / "CMakeLists.txt").stat().st_mtime_ns == stamp
 
     # the workspace sourced as an underlay over this distribution: its setup script chains the other's ROS 2
@@ -129,9 +131,40 @@ def test_a_workspace_built_on_one_distribution_is_refused_on_the_other(tmp_path:
     assert on_top.returncode == 1 and len(on_top.stderr.splitlines()) == 1, on_top.stderr
     assert "two ROS 2 distributions are sourced" in on_top.stderr
     assert all(f"{name} (rclpy " in on_top.stderr for name in DISTROS), on_top.stderr
-    assert not (overlay / "install").exists()
+    explained = subprocess.run(["bash", "-c", sourced + "roc work build --explain"], env=own_env, cwd=overlay,
+                               capture_output=True, text=True, timeout=120)
+    assert explained.returncode == 1 and "two ROS 2 distributions are sourced" in explained.stderr, explained.stderr
+    assert not (overlay / "install").exists() and not (overlay / "build").exists()
     doctor = subprocess.run(["bash", "-c", sourced + "roc doctor --no-daemon --spin-time 0.5 --format json"], env=own_env, cwd=overlay,
                             capture_output=True, text=True, timeout=120)
     found = {f["check"]: f for f in json.loads(doctor.stdout)["findings"]}
     assert found["distribution"]["level"] == "error", doctor.stdout
     assert all(f"{name} (rclpy " in found["distribution"]["message"] for name in DISTROS), doctor.stdout
+    assert doctor.returncode == 1, doctor.stderr
+    assert found["graph"]["level"] == "error" and "not checked" in found["graph"]["message"], doctor.stdout
+
+
+# Each verb that loads rclpy (in roc's process, a daemon's or a launch's), with what stops it early.
+RCLPY_VERBS = (("topic", "list"), ("node", "list", "--no-daemon"), ("daemon", "start"), ("bag", "record", "-a"),
+               ("frame", "pub", "map", "odom"), ("bridge", "/a", "--from-domain", "1", "--to-domain", "2"),
+               ("service", "call", "/s", "std_srvs/srv/Trigger"), ("launch", "demo_py", "nothing.launch.py"))
+
+
+def test_every_verb_that_loads_rclpy_refuses_two_distributions_in_one_line(tmp_path: Path) -> None:
+    """The other distribution's workspace sourced over this one's roc: its rclpy comes first on the paths,
+    and loading it on this distribution's libraries used to end in std::bad_array_new_length and a
+    segmentation fault (exit 139)."""
+    require_both()
+    workspace = tmp_path / "ws"
+    add_cmake_package(workspace, "base", CMAKELISTS.format(name="base"))
+    other_env = env_of(OTHER, 49, tmp_path / "other")
+    assert _run(OTHER, "work", "build", env=other_env, cwd=workspace).returncode == 0
+    own_env = env_of(DISTRO, 49, tmp_path / "own")
+    for verb in RCLPY_VERBS:
+        done = subprocess.run(["bash", "-c", f"source {workspace}/install/setup.bash && roc \"$@\"", "roc", *verb],
+                              env=own_env, cwd=tmp_path, capture_output=True, text=True, timeout=120)
+        assert done.returncode == 1 and done.stdout == "", (verb, done.stdout, done.stderr)
+        assert done.stderr.startswith("roc: error: two ROS 2 distributions are sourced: "), (verb, done.stderr)
+        assert len(done.stderr.splitlines()) == 1 and all(f"{name} (rclpy " in done.stderr for name in DISTROS), \
+            (verb, done.stderr)
+    assert not list((tmp_path / "own").glob("roc/daemon-*.sock")), "no daemon started"

@@ -151,3 +151,30 @@ def test_every_distribution_gets_its_facts() -> None:
     assert distribution.named("lyrical").name == "lyrical"
     assert [distribution.of_rclpy(v) for v in ("7.1.5", "9.1.2", "3.3.16", "42.0.0", "x")] == [
         "jazzy", "kilted", "humble", None, None]
+
+
+GUARDED_IMPORT = """
+import sys
+from roc.distribution import MixedDistributions, guard_rclpy_import
+guard_rclpy_import()
+try:
+    import rclpy.node
+except MixedDistributions as error:
+    print(error, "|", [name for name in sys.modules if name.startswith("rclpy")])
+"""
+
+
+def test_rclpy_is_not_imported_while_two_distributions_are_sourced(tmp_path: Path) -> None:
+    """Pure logic (runs on Jazzy only): an rclpy of another distribution first in the ament index stops the
+    import of rclpy before any of it is loaded (tests/distro/test_cross_distribution.py: the real mix)."""
+    other = tmp_path / "other"
+    (other / "share" / "rclpy").mkdir(parents=True)
+    (other / "share" / "rclpy" / "package.xml").write_text("<package><version>9.1.2</version></package>")
+    env = ros_env(AMENT_PREFIX_PATH=f"{other}:{sys.prefix}")
+    done = subprocess.run([sys.executable, "-c", GUARDED_IMPORT], env=env, capture_output=True, text=True, timeout=60)
+    assert done.stdout.startswith(f"two ROS 2 distributions are sourced: kilted (rclpy 9.1.2 in {other}) and "
+                                  f"{DISTRO} (rclpy "), done.stdout + done.stderr
+    assert done.stdout.endswith("| []\n")
+    clean = subprocess.run([sys.executable, "-c", GUARDED_IMPORT], env=ros_env(AMENT_PREFIX_PATH=sys.prefix),
+                           capture_output=True, text=True, timeout=60)
+    assert (clean.returncode, clean.stdout) == (0, ""), clean.stderr

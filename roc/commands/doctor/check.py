@@ -34,8 +34,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _graph(args: argparse.Namespace) -> tuple[list[Finding], dict[str, Any] | None]:
+    from roc.distribution import mix
     from roc.ros.client import Session
 
+    if mix():  # rclpy would crash on two distributions' libraries: the distribution check says which
+        return [Finding(live_graph.CATEGORY, "graph", "error", "not checked: two ROS 2 distributions are sourced",
+                        "see the distribution check above")], None
     try:
         session = Session(use_daemon=not args.no_daemon, spin_time=args.spin_time)
     except RocError as error:

@@ -105,6 +105,9 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("--launch-prefix-filter goes with --launch-prefix")
     if args.format != "text" and not (args.explain or args.show_args):
         raise UsageError("--format goes with --explain or --show-args")
+    from roc.distribution import refuse_mix
+
+    refuse_mix()  # the runner, the warm start's fork server and the nodes would load both distributions
     kind, path, words = _target(args)
     if kind == "system":
         return _run_system(args, words)

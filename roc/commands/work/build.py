@@ -292,6 +292,9 @@ def _prepare(args: argparse.Namespace):
         force=args.force,
         use_state=not args.no_cache,
     )
+    from roc.builder.layout import check_distribution
+
+    check_distribution(options.build_base, options.install_base)  # --explain too: what the build would say
     remote = remote_cache(args, workspace, options)  # bad settings: a usage error before anything is written
     from roc.cluster.settings import cluster_address
 
@@ -303,7 +306,7 @@ def _locked_build(args, workspace, options, switches: dict[str, bool], remote, e
                   stop: threading.Event | None = None) -> int:
     """Build under the build base's lock. ``extra_handlers`` (roc tui's board and summary) replace the
     console; ``stop`` ends the run as Ctrl+C does."""
-    from roc.builder.layout import prepare_build_base, prepare_distribution, prepare_install_base
+    from roc.builder.layout import prepare_build_base, prepare_install_base, record_distribution
     from roc.builder.lock import build_lock
 
     compiler = None
@@ -316,7 +319,7 @@ def _locked_build(args, workspace, options, switches: dict[str, bool], remote, e
     try:
         with build_lock(options.build_base):
             prepare_build_base(options.build_base)
-            prepare_distribution(options.build_base, options.install_base)
+            record_distribution(options.build_base)
             prepare_install_base(options.install_base, args.merge_install)
             return _build(args, workspace, options, switches, remote, compiler, extra_handlers, stop, cluster)
     finally:
