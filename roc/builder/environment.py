@@ -23,6 +23,9 @@ def base_environment() -> dict[str, str]:
 def build_environment(package: Package, dependencies: list[str], options: BuildOptions) -> dict[str, str]:
     """The base environment plus the install hooks of ``dependencies`` (in dependency order)."""
     env = base_environment()
+    # rosidl's generators list a message's includes from Python sets, whose order follows the string hash
+    # seed: a fixed seed makes the generated sources the same in every build, so a compiler cache hits
+    env.setdefault("PYTHONHASHSEED", "0")
     for name in dependencies:
         prefix = package_prefix(options.install_base, name, options.merge_install)
         dsv = prefix / "share" / name / "package.dsv"
