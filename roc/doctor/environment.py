@@ -12,7 +12,7 @@ from pathlib import Path
 
 from roc import distribution as ros_distribution
 from roc.ament_index import resources
-from roc.doctor import wheel_repairs
+from roc.doctor import build_tools, wheel_defects, wheel_repairs
 from roc.doctor.findings import Finding
 from roc.environment import ament_prefixes, own_prefix, path_list
 
@@ -165,7 +165,9 @@ def wheels(repairs: list[wheel_repairs.Repair] | None = None) -> Finding:
 
 
 def checks(env: Mapping[str, str] = os.environ) -> list[Finding]:
-    return [distribution(env), middleware(env), domain(env), *discovery(env), *overlays(env), wheels()]
+    return [distribution(env), middleware(env), domain(env), *discovery(env), *overlays(env), wheels(),
+            build_tools.tools(env), build_tools.ament_python(env), wheel_defects.missing_packages(env),
+            wheel_defects.linked_rmw(env)]
 
 
 def reports(env: Mapping[str, str] = os.environ) -> dict[str, list[tuple[str, str]]]:

