@@ -2,6 +2,8 @@
 # Set up roc's development/CI environment for one ROS 2 distribution:
 #   bash scripts/setup.sh                   .venv         ROS 2 Jazzy (the default)
 #   bash scripts/setup.sh --distro kilted   .venv-kilted  ROS 2 Kilted
+#   bash scripts/setup.sh --with-cpp        .venv, then the C++ stack (rclcpp from source) built by roc on
+#                                           it in .cpp-stack/ (scripts/setup_cpp.sh)
 # Each is
 #   - a venv made with python3 -m venv (or $PYTHON -m venv),
 #   - roc installed editable with its test extra (pytest, pytest-xdist, colcon as test oracle),
@@ -31,17 +33,22 @@ say() { printf 'setup: %s\n' "$*" >&2; }
 die() { printf 'setup: error: %s\n' "$*" >&2; exit 1; }
 
 DISTRO=jazzy
-case "${1:-}" in
-    --distro) DISTRO="${2:-}"; shift 2 || die "--distro needs a name (jazzy or kilted)" ;;
-    --distro=*) DISTRO="${1#--distro=}"; shift ;;
-    "") ;;
-    *) die "unknown argument '$1' (usage: bash scripts/setup.sh [--distro jazzy|kilted])" ;;
-esac
-[ "$#" -eq 0 ] || die "unknown argument '$1' (usage: bash scripts/setup.sh [--distro jazzy|kilted])"
+WITH_CPP=0
+USAGE="usage: bash scripts/setup.sh [--distro jazzy|kilted] [--with-cpp]"
+while [ "$#" -gt 0 ]; do
+    case "$1" in
+        --distro) DISTRO="${2:-}"; shift 2 || die "--distro needs a name (jazzy or kilted)" ;;
+        --distro=*) DISTRO="${1#--distro=}"; shift ;;
+        --with-cpp) WITH_CPP=1; shift ;;
+        *) die "unknown argument '$1' ($USAGE)" ;;
+    esac
+done
 case "$DISTRO" in
     jazzy|kilted) ;;
     *) die "roc is set up for the ROS 2 distributions jazzy and kilted, not '$DISTRO'" ;;
 esac
+[ "$WITH_CPP" = 0 ] || [ "$DISTRO" = jazzy ] \
+    || die "--with-cpp builds the Jazzy sources of rclcpp: use it without --distro $DISTRO"
 REQUIREMENTS="$ROOT/requirements/ros-$DISTRO.txt"
 # Jazzy, the default, in .venv; any other distribution in a venv of its own
 if [ "$DISTRO" = jazzy ]; then VENV="$ROOT/.venv"; else VENV="$ROOT/.venv-$DISTRO"; fi
@@ -111,6 +118,7 @@ if [ "${ROC_SETUP_FORCE:-0}" != 1 ] && [ -f "$STAMP" ] && venv_ok \
     "$VPY" -m compileall -q "$ROOT/roc" >/dev/null  # only what changed since the last run
     setup_test_tools quiet
     say "environment up to date ($VENV); set ROC_SETUP_FORCE=1 to redo it"
+    [ "$WITH_CPP" = 0 ] || exec bash "$ROOT/scripts/setup_cpp.sh"
     exit 0
 fi
 
@@ -177,3 +185,4 @@ fi
 
 want_stamp >"$STAMP"
 say "done in $((SECONDS - start)) s: ROS 2 $DISTRO; run roc as $VENV/bin/roc (or 'source ${VENV#"$ROOT"/}/bin/activate')"
+[ "$WITH_CPP" = 0 ] || exec bash "$ROOT/scripts/setup_cpp.sh"

@@ -4,6 +4,9 @@
 #   bash scripts/test.sh -k graph -x
 # --distro NAME (first) runs on that ROS 2 distribution's venv instead of Jazzy's .venv:
 #   bash scripts/test.sh --distro kilted          the distribution suite (tests marked distro) on Kilted
+# --with-cpp (first) builds the C++ stack (scripts/setup.sh --with-cpp), then runs the C++ suite (tests
+# marked cpp); the whole suite runs them too once the stack is built, and skips them while it is not:
+#   bash scripts/test.sh --with-cpp
 # (tests/conftest.py: on a distribution other than Jazzy only the tests marked distro run).
 set -euo pipefail
 
@@ -11,13 +14,16 @@ ROOT="$(cd -- "$(dirname -- "${BASH_SOURCE[0]}")/.." && pwd -P)"
 cd "$ROOT"
 
 distro=jazzy
+suite=()  # --with-cpp: the C++ suite, the tests marked cpp
 case "${1:-}" in
     --distro) distro="${2:?test: --distro needs a name (jazzy or kilted)}"; shift 2 ;;
     --distro=*) distro="${1#--distro=}"; shift ;;
+    --with-cpp) suite=(--with-cpp); shift ;;
 esac
 if [ "$distro" = jazzy ]; then venv="$ROOT/.venv"; else venv="$ROOT/.venv-$distro"; fi
 
-bash "$ROOT/scripts/setup.sh" --distro "$distro"
+bash "$ROOT/scripts/setup.sh" --distro "$distro" "${suite[@]}"
+[ "${#suite[@]}" -eq 0 ] || set -- -m cpp "$@"
 
 rc=0
 # loadgroup: tests marked xdist_group("busy_or_timing") share one worker, so the bridge tests' busy
