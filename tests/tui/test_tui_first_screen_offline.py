@@ -165,3 +165,31 @@ def test_endpoints_are_asked_for_again_only_when_counts_change_or_after_a_while(
     feed._endpoints_due = 0.0  # ENDPOINTS_SECONDS later
     feed.snapshot()
     assert asked == [True, False, False, True, True]
+
+
+def test_a_rate_measured_again_after_a_gap_in_its_stream_is_not_low() -> None:
+    """Issue 51: the first screen read 0.7 Hz for a 2.1 Hz topic while roc topic hz said 2.0. Its rates
+    stream starts again whenever the published topics change; a window kept across the gap between two
+    streams counted the messages of a topic with two publishers (no one sequence) over a time that
+    included the gap. Two publishers at 1.05 Hz, a first stream for 4 s, none for 6 s, a second one."""
+    from roc.tui.model import Rates
+
+    def batch(start: float, seconds: float) -> dict:
+        times = sorted([int((start + i / 1.05) * 1e9) for i in range(int(seconds * 1.05))]
+                       + [int((start + 0.3 + i / 1.05) * 1e9) for i in range(int(seconds * 1.05))])
+        sequence = [1 + i // 2 for i in range(len(times))]  # the two publishers' numbers, interleaved
+        return {"topics": {"/y": {"sequence": sequence, "source": times, "received": times,
+                                  "size": [10] * len(times), "stamp": [None] * len(times)}}}
+
+    rates = Rates()
+    rates.restart()
+    rates.add(batch(0.0, 4.0))
+    assert abs(rates.rate("/y") - 2.1) < 0.25
+    rates.restart()  # the topics changed: a new stream, 6 s later
+    assert abs(rates.rate("/y") - 2.1) < 0.25  # the last stream's rate until the new one measures
+    second = batch(10.0, 4.0)
+    columns = second["topics"]["/y"]
+    rates.add({"topics": {"/y": {name: values[:2] for name, values in columns.items()}}})
+    assert abs(rates.rate("/y") - 2.1) < 0.25  # not 3.3 Hz: the two publishers' first messages, 0.3 s apart
+    rates.add({"topics": {"/y": {name: values[2:] for name, values in columns.items()}}})
+    assert abs(rates.rate("/y") - 2.1) < 0.25, rates.rate("/y")  # was 1.05: 8 s of messages over 14 s
