@@ -54,6 +54,9 @@ class RocApp(App[int]):
         self.checks = checks
         self.bag = bag
         self._forward: list[tuple[str, str]] = []  # (kind, name) of the screens Esc left, the last on top
+        from roc.tui.diagnostics_screen import Diagnostics
+
+        self.diagnostics = Diagnostics()  # /diagnostics's statuses, kept while the TUI runs
 
     def on_mount(self) -> None:
         if self._first_build is not None:

@@ -1,21 +1,27 @@
 """Diagnostics: the statuses published on /diagnostics (diagnostic_msgs/DiagnosticArray, decoded by the
 daemon), one row per hardware id and name, the hardware with the worst status first; Enter shows a
-status's values and its history (each change of level or message, with its time)."""
+status's values and its history (each change of level or message, with its time), kept live.
+
+The statuses are the app's (``Diagnostics``, read by ``follow`` from the moment the first screen sees
+/diagnostics until the TUI ends): leaving the view loses no history, and the first screen's problems
+line counts the statuses in ERROR."""
 
 from __future__ import annotations
 
 import time
 from collections import deque
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rich.text import Text
-from textual import work
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.screen import Screen
 from textual.widgets import DataTable, Footer, Static
 from textual.worker import get_current_worker
+
+if TYPE_CHECKING:
+    from textual.app import App
 
 from roc.errors import RocError
 from roc.tui.model import Row
@@ -23,7 +29,7 @@ from roc.tui.widgets import ListTable, TextViewer, host
 
 LEVELS = {0: "OK", 1: "WARN", 2: "ERROR", 3: "STALE"}
 RANK = {2: 3, 3: 2, 1: 1, 0: 0}  # worst first: an error, then stale data, then a warning
-HISTORY = 200  # changes kept per status
+HISTORY = 10000  # changes kept per status (a status that changes every second: about 3 hours)
 
 
 def level_number(level: Any) -> int:
@@ -76,6 +82,50 @@ def rows(statuses: dict[str, Status]) -> list[Row]:
                 problems.get(s.level, ["error"])) for s in ordered]
 
 
+class Diagnostics:
+    """The statuses of a diagnostics topic, by key, as they came since the TUI began to follow it."""
+
+    def __init__(self, topic: str = "/diagnostics") -> None:
+        self.topic = topic
+        self.statuses: dict[str, Status] = {}
+        self.messages = 0
+        self.following = False  # a stream reads the topic into these statuses
+
+    def take(self, messages: list[dict[str, Any]]) -> None:
+        for message in messages:
+            when = message["time"] * 1e-9
+            for value in message["value"]["status"]:
+                key = f"{value['hardware_id']}\t{value['name']}"
+                self.statuses.setdefault(key, Status(value["hardware_id"], value["name"])).update(value, when)
+        self.messages += len(messages)
+
+    def errors(self) -> list[Status]:
+        """The statuses in ERROR now."""
+        return [status for status in self.statuses.values() if status.level == 2]
+
+
+def follow(app: App) -> None:
+    """Read the app's ``diagnostics`` topic into them from now until the app ends (the stream waits for
+    the topic to appear); once (again after a stream that failed)."""
+    store = app.diagnostics  # type: ignore[attr-defined]
+    if store.following:
+        return
+    store.following = True
+
+    def read() -> None:
+        worker = get_current_worker()
+        try:
+            for event in host(app).feed.stream("values", {"topic": store.topic}, lambda: worker.is_cancelled):
+                if event["event"] == "values":
+                    app.call_from_thread(store.take, event["messages"])
+        except RocError as error:
+            app.call_from_thread(app.notify, f"diagnostics: {error}", severity="error")
+        finally:
+            store.following = False
+
+    app.run_worker(read, thread=True, exclusive=True, group="diagnostics")
+
+
 class DiagnosticsScreen(Screen):
     BINDINGS = [
         Binding("escape", "app.pop_screen", "back"),
@@ -86,47 +136,32 @@ class DiagnosticsScreen(Screen):
     DiagnosticsScreen ListTable { height: 1fr; }
     """
 
-    def __init__(self, topic: str = "/diagnostics") -> None:
-        super().__init__()
-        self.topic = topic
-        self.statuses: dict[str, Status] = {}
-        self.messages = 0
+    @property
+    def store(self) -> Diagnostics:
+        return self.app.diagnostics  # type: ignore[attr-defined]
+
+    @property
+    def statuses(self) -> dict[str, Status]:
+        return self.store.statuses
 
     def compose(self) -> ComposeResult:
-        yield Static(Text(f"diagnostics: {self.topic}, waiting for a status...", style="bold"), id="title")
+        yield Static(Text(f"diagnostics: {self.store.topic}, waiting for a status...", style="bold"), id="title")
         yield ListTable(("level", "hardware id", "name", "message"), marks=True, id="statuses")
         yield Footer()
 
     def on_mount(self) -> None:
         self.query_one("#statuses").focus()
-        self.read()
+        follow(self.app)
+        self.draw()
         self.set_interval(1.0, self.draw)
-
-    @work(thread=True, exclusive=True, group="diagnostics")
-    def read(self) -> None:
-        worker = get_current_worker()
-        try:
-            for event in host(self).feed.stream("values", {"topic": self.topic}, lambda: worker.is_cancelled):
-                if event["event"] == "values":
-                    self.app.call_from_thread(self.take, event["messages"])
-        except RocError as error:
-            self.app.call_from_thread(self.notify, f"diagnostics: {error}", severity="error")
-
-    def take(self, messages: list[dict[str, Any]]) -> None:
-        for message in messages:
-            when = message["time"] * 1e-9
-            for value in message["value"]["status"]:
-                key = f"{value['hardware_id']}\t{value['name']}"
-                self.statuses.setdefault(key, Status(value["hardware_id"], value["name"])).update(value, when)
-        self.messages += len(messages)
 
     def draw(self) -> None:
         if not self.statuses:
             return
         counts = {name: sum(1 for s in self.statuses.values() if s.level == level) for level, name in LEVELS.items()}
         summary = "  ".join(f"{count} {name}" for name, count in counts.items() if count)
-        self.query_one("#title", Static).update(Text(f"diagnostics: {self.topic}  {summary}  (Enter: values and "
-                                                     "history)", style="bold"))
+        self.query_one("#title", Static).update(Text(f"diagnostics: {self.store.topic}  {summary}  (Enter: values "
+                                                     "and history)", style="bold"))
         self.query_one("#statuses", ListTable).show(rows(self.statuses))
 
     def on_data_table_row_selected(self, event: DataTable.RowSelected) -> None:
@@ -136,6 +171,8 @@ class DiagnosticsScreen(Screen):
         self.show_details(self.query_one("#statuses", ListTable).selected_key())
 
     def show_details(self, key: str | None) -> None:
+        """The status's values and history, drawn again every second as new messages come."""
         if key in self.statuses:
-            self.app.push_screen(TextViewer(f"diagnostic status {self.statuses[key].name} (Esc: back)",
-                                            self.statuses[key].details()))
+            status = self.statuses[key]
+            self.app.push_screen(TextViewer(f"diagnostic status {status.name} (Esc: back)", status.details(),
+                                            follow=status.details))

@@ -1,7 +1,7 @@
 """The first screen: the system at a glance. Nodes (with their process's CPU and memory) beside topics
 (publishers, subscribers, live rate and bandwidth, type), then services, actions and a workspace's
-packages in tabs; counts in the header; a line that counts the real problems (roc.tui.problems), ``p``
-going to each in turn; ``/`` filters the list shown."""
+packages in tabs; counts in the header; a line that counts the real problems (roc.tui.problems: the
+graph's, and the /diagnostics statuses in ERROR), ``p`` going to each in turn; ``/`` filters the list shown."""
 
 from __future__ import annotations
 
@@ -40,6 +40,7 @@ SYSTEM = ("nodes", "topics")
 # below this many columns, the nodes are above the topics instead of beside them: beside them, the topics'
 # names and types would get some 10 columns each
 NARROW = 120
+DIAGNOSTICS = "/diagnostics"  # followed from when it is published: its statuses in ERROR are problems
 
 
 class ListTabs(TabbedContent):
@@ -167,7 +168,13 @@ class GraphScreen(Screen):
                                                  for kind in ("nodes", "topics", "services", "actions")))
         topics = visible(snapshot["topics"], self.hidden)
         nodes = [n["full_name"] for n in visible(snapshot["nodes"], self.hidden)]
-        self.problems = self.problem_watch.problems(topics, nodes, self.rates.rate)
+        if any(t["name"] == DIAGNOSTICS and t["publishers"] for t in topics):
+            from roc.tui.diagnostics_screen import follow
+
+            follow(self.app)
+        self.problems = self.problem_watch.problems(topics, nodes, self.rates.rate, [
+            (s.key, f"{DIAGNOSTICS} {s.name}: ERROR {s.message} (:diagnostics)")
+            for s in self.app.diagnostics.errors()])  # type: ignore[attr-defined]
         self.show_problems()
         gone = self.problem_watch.nodes_gone(nodes)
         self.table("nodes").show(node_rows(snapshot, self.hidden, usage or self.processes.usage, gone))
@@ -214,6 +221,7 @@ class GraphScreen(Screen):
     @work(thread=True, exclusive=True, group="rates")
     def measure(self, topics: list[str]) -> None:
         worker = get_current_worker()
+        self.app.call_from_thread(self.rates.restart)
         try:
             measure_rates(host(self).feed, topics, lambda event: self.app.call_from_thread(self.rates.add, event),
                           lambda: worker.is_cancelled)
@@ -334,6 +342,9 @@ class GraphScreen(Screen):
             return
         self.problem_index = (self.problem_index + 1) % len(self.problems)
         problem = self.problems[self.problem_index]
+        if problem.kind == "diagnostic":  # in the diagnostics view, not in a list here: said on the line
+            self.show_problems()
+            return
         self.action_show_tab(f"{problem.kind}s")
         table = self.table(f"{problem.kind}s")
         if problem.name not in table.rows_by_key and table.filter:

@@ -2,12 +2,14 @@
 listens to is not (a sensor publishes for whoever comes; /rosout and /parameter_events have no
 subscriber on a healthy system); these are: QoS or type incompatibility between endpoints, a
 subscriber with no publisher, a rate below the ``min-rate`` roc.toml's ``[check]`` expects (or an
-expected topic or node missing), and a node that was on the graph and is gone. Plain data, no Textual.
+expected topic or node missing), a node that was on the graph and is gone, and a /diagnostics status in
+ERROR. Plain data, no Textual.
 """
 
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -20,7 +22,7 @@ NO_PUBLISHER = "no publisher"
 
 @dataclass(frozen=True)
 class Problem:
-    kind: str  # topic or node: the list the problem's row is in
+    kind: str  # topic or node: the list the problem's row is in; or diagnostic
     name: str
     text: str
     severity: str = "error"  # error or warning
@@ -64,9 +66,11 @@ class Watch:
     def forget_gone(self) -> None:
         self.seen = {node: when for node, when in self.seen.items() if when == max(self.seen.values(), default=0)}
 
-    def problems(self, topics: list[dict[str, Any]], nodes: list[str], rate) -> list[Problem]:
-        """``topics``, ``nodes``: what is shown; ``rate(topic)``: its measured rate or None."""
-        found = []
+    def problems(self, topics: list[dict[str, Any]], nodes: list[str], rate,
+                 diagnostic_errors: Sequence[tuple[str, str]] = ()) -> list[Problem]:
+        """``topics``, ``nodes``: what is shown; ``rate(topic)``: its measured rate or None;
+        ``diagnostic_errors``: (key, text) of each /diagnostics status in ERROR."""
+        found = [Problem("diagnostic", key, text) for key, text in diagnostic_errors]
         for topic in topics:
             for text in topic_diagnoses(topic):
                 found.append(Problem("topic", topic["name"], f"{topic['name']}: {text}",

@@ -246,9 +246,10 @@ class TextViewer(ModalScreen[None]):
     TextViewer TextArea { height: 1fr; }
     """
 
-    def __init__(self, title: str, text: str) -> None:
+    def __init__(self, title: str, text: str, follow: Callable[[], str] | None = None) -> None:
+        """``follow``: the text drawn again every second (where the reader scrolled to kept)."""
         super().__init__()
-        self.title_text, self.text = title, text
+        self.title_text, self.text, self.follow = title, text, follow
 
     def compose(self) -> ComposeResult:
         with Vertical():
@@ -256,6 +257,21 @@ class TextViewer(ModalScreen[None]):
             from textual.widgets import TextArea  # not before a viewer opens: a first screen without it is faster
 
             yield TextArea(self.text, read_only=True, soft_wrap=False, id="viewer")
+
+    def on_mount(self) -> None:
+        if self.follow is not None:
+            self.set_interval(1.0, self.draw_again)
+
+    def draw_again(self) -> None:
+        from textual.widgets import TextArea
+
+        assert self.follow is not None
+        text = self.follow()
+        viewer = self.query_one("#viewer", TextArea)
+        if text != viewer.text:
+            scrolled = viewer.scroll_offset
+            viewer.text = text
+            viewer.scroll_to(scrolled.x, scrolled.y, animate=False)
 
     def action_close(self) -> None:
         self.dismiss(None)
