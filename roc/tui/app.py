@@ -55,8 +55,10 @@ class RocApp(App[int]):
         self.bag = bag
         self._forward: list[tuple[str, str]] = []  # (kind, name) of the screens Esc left, the last on top
         from roc.tui.diagnostics_screen import Diagnostics
+        from roc.tui.logs_screen import Logs
 
         self.diagnostics = Diagnostics()  # /diagnostics's statuses, kept while the TUI runs
+        self.logs = Logs()  # /rosout, kept while the TUI runs
 
     def on_mount(self) -> None:
         if self._first_build is not None:

@@ -2,7 +2,7 @@
 daemon), one row per hardware id and name, the hardware with the worst status first; Enter shows a
 status's values and its history (each change of level or message, with its time), kept live.
 
-The statuses are the app's (``Diagnostics``, read by ``follow`` from the moment the first screen sees
+The statuses are the app's (``Diagnostics``, read by roc.tui.widgets.follow from the moment the first screen sees
 /diagnostics until the TUI ends): leaving the view loses no history, and the first screen's problems
 line counts the statuses in ERROR."""
 
@@ -11,21 +11,16 @@ from __future__ import annotations
 import time
 from collections import deque
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from rich.text import Text
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.screen import Screen
 from textual.widgets import DataTable, Footer, Static
-from textual.worker import get_current_worker
 
-if TYPE_CHECKING:
-    from textual.app import App
-
-from roc.errors import RocError
 from roc.tui.model import Row
-from roc.tui.widgets import ListTable, TextViewer, host
+from roc.tui.widgets import ListTable, TextViewer, follow
 
 LEVELS = {0: "OK", 1: "WARN", 2: "ERROR", 3: "STALE"}
 RANK = {2: 3, 3: 2, 1: 1, 0: 0}  # worst first: an error, then stale data, then a warning
@@ -87,6 +82,7 @@ class Diagnostics:
 
     def __init__(self, topic: str = "/diagnostics") -> None:
         self.topic = topic
+        self.params = {"topic": topic}
         self.statuses: dict[str, Status] = {}
         self.messages = 0
         self.following = False  # a stream reads the topic into these statuses
@@ -102,28 +98,6 @@ class Diagnostics:
     def errors(self) -> list[Status]:
         """The statuses in ERROR now."""
         return [status for status in self.statuses.values() if status.level == 2]
-
-
-def follow(app: App) -> None:
-    """Read the app's ``diagnostics`` topic into them from now until the app ends (the stream waits for
-    the topic to appear); once (again after a stream that failed)."""
-    store = app.diagnostics  # type: ignore[attr-defined]
-    if store.following:
-        return
-    store.following = True
-
-    def read() -> None:
-        worker = get_current_worker()
-        try:
-            for event in host(app).feed.stream("values", {"topic": store.topic}, lambda: worker.is_cancelled):
-                if event["event"] == "values":
-                    app.call_from_thread(store.take, event["messages"])
-        except RocError as error:
-            app.call_from_thread(app.notify, f"diagnostics: {error}", severity="error")
-        finally:
-            store.following = False
-
-    app.run_worker(read, thread=True, exclusive=True, group="diagnostics")
 
 
 class DiagnosticsScreen(Screen):
@@ -151,7 +125,7 @@ class DiagnosticsScreen(Screen):
 
     def on_mount(self) -> None:
         self.query_one("#statuses").focus()
-        follow(self.app)
+        follow(self.app, self.store)
         self.draw()
         self.set_interval(1.0, self.draw)
 

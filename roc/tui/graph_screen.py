@@ -23,7 +23,7 @@ from roc.tui.feed import measure_rates
 from roc.tui.model import Rates, counts, node_rows, topic_rows, typed_rows, visible
 from roc.tui.problems import Problem, Watch
 from roc.tui.processes import Processes
-from roc.tui.widgets import ListTable, host
+from roc.tui.widgets import ListTable, follow, host
 
 REFRESH_SECONDS = 1.0
 # the topics' columns whose values change every second, at the widths of their longest values
@@ -132,6 +132,7 @@ class GraphScreen(Screen):
         self.query_one("#system").set_class(event.size.width < NARROW, "narrow")
 
     def on_mount(self) -> None:
+        follow(self.app, self.app.logs)  # type: ignore[attr-defined]  # /rosout from the start: the logs view's backlog
         self.poll()
         self.set_interval(REFRESH_SECONDS, self.poll)
         if self.workspace is not None:
@@ -169,9 +170,7 @@ class GraphScreen(Screen):
         topics = visible(snapshot["topics"], self.hidden)
         nodes = [n["full_name"] for n in visible(snapshot["nodes"], self.hidden)]
         if any(t["name"] == DIAGNOSTICS and t["publishers"] for t in topics):
-            from roc.tui.diagnostics_screen import follow
-
-            follow(self.app)
+            follow(self.app, self.app.diagnostics)  # type: ignore[attr-defined]
         self.problems = self.problem_watch.problems(topics, nodes, self.rates.rate, [
             (s.key, f"{DIAGNOSTICS} {s.name}: ERROR {s.message} (:diagnostics)")
             for s in self.app.diagnostics.errors()])  # type: ignore[attr-defined]

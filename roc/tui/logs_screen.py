@@ -1,9 +1,15 @@
 """Logs: /rosout live (the daemon decodes it: its ``values`` stream), or the output of a process ``roc
-launch`` started (roc.launch.status), one line per entry; filtered by level (``l`` raises the least
-level shown), node (``n``) and text (``/``); Space pauses and resumes following."""
+launch`` started (roc.launch.status), one line per entry in the order of their times; filtered by level
+(``l`` raises the least level shown), node (``n``) and text (``/``); Space pauses and resumes following.
+
+/rosout is the app's (``Logs``, followed from the first screen's start until the TUI ends): what came
+since the TUI started, and before that the history each node's /rosout publisher keeps for a new
+subscriber (rcl's profile: transient local, the last 1000 entries, each for 10 s: its lifespan). The
+histories come one publisher after another, so entries are kept sorted by their stamps."""
 
 from __future__ import annotations
 
+import bisect
 import time
 from collections import deque
 from collections.abc import Iterable
@@ -18,9 +24,12 @@ from textual.widgets import Footer, RichLog, Static
 from textual.worker import get_current_worker
 
 from roc.errors import RocError
-from roc.tui.widgets import Prompt, host
+from roc.tui.widgets import Prompt, follow
 
 KEPT = 20000  # entries kept (the filters apply to them all)
+# the history rcl's /rosout publishers keep for a new subscriber (rcl_qos_profile_rosout_default)
+ROSOUT_LIFESPAN = 10
+ROSOUT_DEPTH = 1000
 LEVELS = {10: "DEBUG", 20: "INFO", 30: "WARN", 40: "ERROR", 50: "FATAL"}
 STYLES = {10: "dim", 20: "", 30: "yellow", 40: "red", 50: "bold red"}
 
@@ -42,6 +51,32 @@ def rosout_entry(value: dict) -> Entry:
     """A decoded rcl_interfaces/msg/Log."""
     stamp = value["stamp"]["sec"] + value["stamp"]["nanosec"] / 1e9
     return Entry(stamp, value["level"], value["name"], value["msg"])
+
+
+class Logs:
+    """/rosout's entries in the order of their stamps, as they came since the TUI began to follow it."""
+
+    def __init__(self) -> None:
+        # keep_all: the histories of every node come at once, more than a keep-last reader's depth holds
+        self.params = {"topic": "/rosout", "qos": {"history": "keep_all"}}
+        self.following = False
+        self.entries: list[Entry] = []
+        self.since = time.time()  # when the TUI began to follow /rosout
+        self.readers: list = []  # called with each batch of entries taken (the logs screens shown)
+
+    def take(self, messages: list[dict]) -> None:
+        entries = [rosout_entry(m["value"]) for m in messages]
+        for entry in entries:
+            bisect.insort(self.entries, entry, key=lambda e: e.stamp)
+        del self.entries[:len(self.entries) - KEPT]
+        for reader in self.readers:
+            reader(entries)
+
+    def reach(self) -> str:
+        """How far back the entries go, and why no further."""
+        first = time.strftime("%H:%M:%S", time.localtime(self.entries[0].stamp)) if self.entries else "-"
+        return (f"from {first}: since roc tui started, and before that the {ROSOUT_LIFESPAN} s (at most "
+                f"{ROSOUT_DEPTH} entries) each node's /rosout keeps")
 
 
 def logger_name(node: str) -> str:
@@ -80,11 +115,13 @@ class LogsScreen(Screen):
         """``node``: start filtered to its lines; ``process`` of ``launch`` (a roc.launch.status
         RunStatus): that process's output instead of /rosout."""
         super().__init__()
-        self.entries: deque[Entry] = deque(maxlen=KEPT)
+        self.entries: deque[Entry] | list[Entry] = deque(maxlen=KEPT)  # /rosout's: the app's Logs
         self.least, self.node, self.text = 10, logger_name(node) if node else "", ""
         self.following = True
         self.process, self.launch = process, launch
         self.pending: list[Entry] = []  # arrived while paused
+        self.last_stamp = float("-inf")  # of the last line written
+        self.redraw_due = False
 
     def compose(self) -> ComposeResult:
         yield Static("", id="title")
@@ -92,8 +129,19 @@ class LogsScreen(Screen):
         yield Footer()
 
     def on_mount(self) -> None:
-        self.draw_title()
-        self.read()
+        if self.process:
+            self.draw_title()
+            self.read()
+            return
+        logs = self.app.logs  # type: ignore[attr-defined]
+        self.entries = logs.entries
+        logs.readers.append(self.arrived)
+        follow(self.app, logs)
+        self.redraw()
+
+    def on_unmount(self) -> None:
+        if not self.process:
+            self.app.logs.readers.remove(self.arrived)  # type: ignore[attr-defined]
 
     @property
     def source(self) -> str:
@@ -106,43 +154,51 @@ class LogsScreen(Screen):
         if self.text:
             filters.append(f"text '{self.text}'")
         state = "following (Space: pause)" if self.following else f"paused, {len(self.pending)} new (Space: resume)"
-        self.query_one("#title", Static).update(Text(f"logs: {self.source}  {', '.join(filters)}  {state}",
+        reach = "" if self.process else f"  {self.app.logs.reach()}"  # type: ignore[attr-defined]
+        self.query_one("#title", Static).update(Text(f"logs: {self.source}  {', '.join(filters)}  {state}{reach}",
                                                      style="bold"))
 
     @work(thread=True, exclusive=True, group="logs")
     def read(self) -> None:
+        """A process's output (/rosout is the app's: roc.tui.widgets.follow)."""
         worker = get_current_worker()
         try:
-            if self.process and self.launch is not None:
-                for lines in self.launch.follow(self.process, lambda: worker.is_cancelled):
-                    now = time.time()
-                    self.app.call_from_thread(self.take, [Entry(now, level_of(line), self.process, line)
-                                                          for line in lines])
-                return
-            for event in host(self).feed.stream("values", {"topic": "/rosout"}, lambda: worker.is_cancelled):
-                if event["event"] == "values":
-                    self.app.call_from_thread(self.take, [rosout_entry(m["value"]) for m in event["messages"]])
+            for lines in self.launch.follow(self.process, lambda: worker.is_cancelled):
+                now = time.time()
+                self.app.call_from_thread(self.take, [Entry(now, level_of(line), self.process, line)
+                                                      for line in lines])
         except (RocError, OSError) as error:
             self.app.call_from_thread(self.notify, f"logs: {error}", severity="error")
 
     def take(self, entries: Iterable[Entry]) -> None:
         entries = list(entries)
         self.entries.extend(entries)
-        if self.following:
-            self.write(entries)
-        else:
+        self.arrived(entries)
+
+    def arrived(self, entries: list[Entry]) -> None:
+        """Entries kept since the last: written after the last line when none is older, else every line
+        written again in order (soon: a node's history comes in several batches)."""
+        if not self.following:
             self.pending += entries
             self.draw_title()
+        elif all(entry.stamp >= self.last_stamp for entry in entries):
+            self.write(entries)
+        elif not self.redraw_due:
+            self.redraw_due = True
+            self.set_timer(0.2, self.redraw)
 
     def write(self, entries: Iterable[Entry]) -> None:
         log = self.query_one("#log", RichLog)
         for entry in entries:
             if shown(entry, self.least, self.node, self.text):
                 log.write(entry.line(), scroll_end=self.following)
+            self.last_stamp = max(self.last_stamp, entry.stamp)
 
     def redraw(self) -> None:
+        self.redraw_due = False
         self.query_one("#log", RichLog).clear()
         self.pending = []
+        self.last_stamp = float("-inf")
         self.write(self.entries)
         self.draw_title()
 
@@ -153,9 +209,9 @@ class LogsScreen(Screen):
     def action_follow(self) -> None:
         self.following = not self.following
         if self.following:
-            self.write(self.pending)
-            self.pending = []
-        self.draw_title()
+            self.redraw()  # what came while paused, each line in its place
+        else:
+            self.draw_title()
 
     def action_level(self) -> None:
         levels = list(LEVELS)

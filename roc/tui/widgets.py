@@ -4,7 +4,7 @@ a one-line prompt, a text viewer and the help screen."""
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from typing import Protocol, cast
+from typing import Any, Protocol, cast
 
 from rich.text import Text
 from textual.app import ComposeResult
@@ -33,6 +33,40 @@ class Host(Protocol):
 
 def host(widget) -> Host:
     return cast(Host, widget.app)
+
+
+class Followed(Protocol):
+    """What the app keeps of a topic while the TUI runs (its diagnostics, its logs)."""
+
+    params: dict[str, Any]  # of the daemon's ``values`` stream
+    following: bool  # a stream reads the topic into it
+
+    def take(self, messages: list[dict[str, Any]]) -> None: ...
+
+
+def follow(app, kept: Followed) -> None:
+    """Read ``kept``'s topic into it from now until the app ends (the stream waits for the topic to
+    appear); once (again after a stream that failed)."""
+    from textual.worker import get_current_worker
+
+    from roc.errors import RocError
+
+    if kept.following:
+        return
+    kept.following = True
+
+    def read() -> None:
+        worker = get_current_worker()
+        try:
+            for event in host(app).feed.stream("values", kept.params, lambda: worker.is_cancelled):
+                if event["event"] == "values":
+                    app.call_from_thread(kept.take, event["messages"])
+        except RocError as error:
+            app.call_from_thread(app.notify, f"{kept.params['topic']}: {error}", severity="error")
+        finally:
+            kept.following = False
+
+    app.run_worker(read, thread=True, group=f"follow {kept.params['topic']}")
 
 
 WARNINGS = (NO_PUBLISHER, "duplicate name", "warning")
