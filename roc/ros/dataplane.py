@@ -13,6 +13,7 @@ endpoint, so an interrupted client leaves none behind.
 from __future__ import annotations
 
 import base64
+import itertools
 import struct
 import time
 from collections.abc import Callable, Hashable
@@ -31,7 +32,7 @@ from rclpy.serialization import deserialize_message
 from roc.errors import RocError
 from roc.ros.content_filter import ContentFilter
 from roc.ros.messages import value_to_data
-from roc.ros.protocol import HEARTBEAT_SECONDS, Events, full_name
+from roc.ros.protocol import HEARTBEAT_SECONDS, Events, full_name, task_node_name
 from roc.ros.raw_subscription import Receiver, gid_text
 from roc.ros.types import TF_TYPE, message_class
 
@@ -40,6 +41,8 @@ MAX_BATCH = 1000  # messages in one ``messages`` event
 # being dropped (ros2 topic echo keeps 5; a bridge kept 10 and lost 0.8 % at 5 kHz).
 RECEIVE_DEPTH = 1000
 POLL_SECONDS = 0.05
+# numbers the nodes of publishing streams whose client named none
+UNNAMED_PUBLISHERS = itertools.count(1)
 _POLICIES = {"history": HistoryPolicy, "reliability": ReliabilityPolicy, "durability": DurabilityPolicy,
              "liveliness": LivelinessPolicy}
 
@@ -213,12 +216,17 @@ def publish(graph, params: dict[str, Any], prepare: Callable[[], bytes] | None =
     ``times`` messages (0: until closed) at ``rate`` Hz (``value``, plain data, in place of ``data``: for a
     client that loads no rclpy), ``{"event": "published", "count"}`` after each,
     keeping the publisher ``keep_alive`` seconds after the last (null: until closed). In-process only:
-    ``prepare`` gives the CDR to send before each message (stamped with the time)."""
+    ``prepare`` gives the CDR to send before each message (stamped with the time).
+
+    The publisher is on a node of its own, ``node`` (roc.ros.protocol.task_node_name; default
+    ``roc_pub_<pid>_<n>``), not on the graph's hidden one: a topic the user asked roc to publish is
+    listed like any other, under a node named for what publishes it."""
     cls = message_class(params["type"])
     data = base64.b64decode(params["data"]) if "data" in params else _filled(cls, params["value"])
     profile = qos_profile({"profile": "default", **params.get("qos", {})})
-    publisher = graph.node.create_publisher(cls, params["topic"], profile)
+    node = graph.task_node(params.get("node") or f"{task_node_name('pub')}_{next(UNNAMED_PUBLISHERS)}")
     try:
+        publisher = node.create_publisher(cls, params["topic"], profile)
         wanted, max_wait = params.get("wait", 0), params.get("max_wait")
         started = next_notice = time.monotonic()
         while publisher.get_subscription_count() < wanted:
@@ -250,7 +258,7 @@ def publish(graph, params: dict[str, Any], prepare: Callable[[], bytes] | None =
             time.sleep(min(remaining, HEARTBEAT_SECONDS))
             yield {"event": "heartbeat"}
     finally:
-        graph.node.destroy_publisher(publisher)
+        node.destroy_node()  # and its publisher
 
 
 def _filled(cls, value: Any) -> bytes:

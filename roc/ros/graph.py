@@ -156,8 +156,9 @@ def use_profile(profile: Path, environment: MutableMapping[str, str] = os.enviro
 
 
 class Graph:
-    """A hidden rclpy node in its own context, spun in a background thread (for service calls); in
-    ``domain_id`` when given, else in the environment's ROS domain. Its participant takes Fast DDS's
+    """An rclpy node in its own context (by default roc's own, hidden: see is_own_node), spun in a
+    background thread (for service calls); in ``domain_id`` when given, else in the environment's ROS
+    domain. Its participant takes Fast DDS's
     settings from ``profile`` (unless the user chose a profile file): PARTICIPANT_PROFILE, or
     BRIDGE_PROFILE for a bridge's. Both announce the participant every 0.5 s."""
 
@@ -175,14 +176,7 @@ class Graph:
         self.context = Context()
         rclpy.init(args=[], context=self.context, signal_handler_options=SignalHandlerOptions.NO, domain_id=domain_id)
         OPEN_GRAPHS.add(id(self))
-        # roc's own node shows as little as it can, to other tools too: no parameter, type description
-        # or /rosout endpoints, and no /parameter_events publisher (its parameters never change)
-        self.node = Node(node_name or own_node_name(os.getpid()), context=self.context, start_parameter_services=False,
-                         enable_rosout=False, cli_args=list(arguments),
-                         parameter_overrides=[Parameter("start_type_description_service", value=False)])
-        for publisher in list(self.node.publishers):
-            if publisher.topic_name == "/parameter_events":
-                self.node.destroy_publisher(publisher)
+        self.node = self.task_node(node_name or own_node_name(os.getpid()), arguments)
         enlarge_input_buffers(self.context.get_domain_id())
         ask_local_participants_to_announce(self.context.get_domain_id())
         self.events = events
@@ -223,6 +217,19 @@ class Graph:
         rclpy.try_shutdown(context=self.context)
         self.node.destroy_node()
         OPEN_GRAPHS.discard(id(self))  # rmw deleted the participant at the shutdown
+
+    def task_node(self, name: str, arguments: Sequence[str] = ()) -> Node:
+        """A node of this participant that shows only the endpoints made on it, to other tools too: no
+        parameter, type description or /rosout endpoints, and no /parameter_events publisher (its
+        parameters never change). The graph's own node, and the node a stream publishes from
+        (roc.ros.dataplane.publish, which destroys it when the stream ends; not spun)."""
+        node = Node(name, context=self.context, start_parameter_services=False, enable_rosout=False,
+                    cli_args=list(arguments),
+                    parameter_overrides=[Parameter("start_type_description_service", value=False)])
+        for publisher in list(node.publishers):
+            if publisher.topic_name == "/parameter_events":
+                node.destroy_publisher(publisher)
+        return node
 
     def on_spinner(self, function: Callable[[], Any]) -> Future:
         """Run ``function()`` on the thread that spins the node, between two callbacks; the future's

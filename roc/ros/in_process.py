@@ -32,11 +32,9 @@ def query(method: str, params: dict[str, Any], spin_time: float | None) -> Any:
         graph.close()
 
 
-def stream(method: str, params: dict[str, Any], node_name: str | None = None,
-           **in_process: Any) -> Events:
-    """A stream without the daemon: its endpoint on a fresh participant of this process, on a node
-    named ``node_name`` (default: a hidden one)."""
-    graph = Graph(node_name)
+def stream(method: str, params: dict[str, Any], **in_process: Any) -> Events:
+    """A stream without the daemon: its endpoints on a fresh participant of this process."""
+    graph = Graph()
     try:
         yield from run_on(graph, method, params, **in_process)
     finally:

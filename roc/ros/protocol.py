@@ -41,6 +41,13 @@ def is_own_node(name: str) -> bool:
     return name.startswith(OWN_NODE_PREFIX) and name[len(OWN_NODE_PREFIX):].isdigit()
 
 
+def task_node_name(task: str, pid: int | None = None) -> str:
+    """The node of something a user asked roc to do, named for it (``frame_pub`` -> ``roc_frame_pub_<pid>``,
+    of the process that asked): what it publishes is listed like any other node's, unlike what roc's own
+    nodes do (see OWN_NODE_PREFIX)."""
+    return f"roc_{task}_{os.getpid() if pid is None else pid}"
+
+
 def discovery_environment(env: Mapping[str, str] | None = None) -> dict[str, str]:
     env = os.environ if env is None else env
     return {name: env.get(name, "") for name in DISCOVERY_VARIABLES}

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 from helpers.build import BIN, NODES, stop_process
-from helpers.graph import graph_env, read_line, stop_daemon, with_tf2_msgs
+from helpers.graph import graph_env, install_oracle, read_line, ros2, stop_daemon, wait_for, with_tf2_msgs
 
 pytestmark = pytest.mark.slow
 TF_NODE = NODES / "tf_node.py"
@@ -105,10 +105,10 @@ def test_monitor_gives_rate_delay_and_node_per_frame(tree) -> None:
 
 
 def test_a_frame_sent_by_two_nodes_names_both(tree) -> None:
-    """A conflict a ROS user wants to see: lens also published by roc frame pub (its own node, /_roc_<pid>)."""
+    """A conflict a ROS user wants to see: lens also published by roc frame pub (its node, /roc_frame_pub_<pid>)."""
     pub = subprocess.Popen([str(BIN / "roc"), "frame", "pub", "camera", "lens", "--z", "2", "--rate", "10",
                             "--duration", "20"], env=tree, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-    both, deadline = sorted([f"/_roc_{pub.pid}", "/tf_camera"]), time.monotonic() + 30
+    both, deadline = sorted([f"/roc_frame_pub_{pub.pid}", "/tf_camera"]), time.monotonic() + 30
     try:
         assert (read_line(pub) or "").startswith("publishing camera -> lens on /tf at 10 Hz")
         while True:  # (until the daemon has discovered the fresh publisher)
@@ -119,6 +119,36 @@ def test_a_frame_sent_by_two_nodes_names_both(tree) -> None:
     finally:
         stop_process(pub)
     assert lens == both
+
+
+def test_what_frame_pub_publishes_is_listed_under_a_node_named_for_it_as_ros2_lists_it(tmp_path: Path) -> None:
+    """roc frame pub publishes from the daemon, on a node of its own, /roc_frame_pub_<pid> (issue 51: on the
+    daemon's hidden node, roc's lists left /tf_static out, which ros2 lists). A domain of its own: no
+    other /tf_static publisher."""
+    env = with_tf2_msgs(graph_env(7, tmp_path))
+    pub = subprocess.Popen([str(BIN / "roc"), "frame", "pub", "map", "odom"], env=env, stdout=subprocess.PIPE,
+                           stderr=subprocess.DEVNULL, text=True)
+    node = f"roc_frame_pub_{pub.pid}"
+    try:
+        assert (read_line(pub) or "").startswith("publishing map -> odom on /tf_static")
+        listed = subprocess.run([str(BIN / "roc"), "topic", "list"], env=env, capture_output=True, text=True, timeout=60)
+        assert "/tf_static" in listed.stdout.splitlines(), listed.stdout
+        info = subprocess.run([str(BIN / "roc"), "topic", "info", "/tf_static", "-v"], env=env, capture_output=True,
+                              text=True, timeout=60)
+        assert info.returncode == 0, info.stderr
+        assert "Publisher count: 1" in info.stdout and f"Node name: {node}\n" in info.stdout, info.stdout
+        nodes = subprocess.run([str(BIN / "roc"), "node", "list"], env=env, capture_output=True, text=True, timeout=60)
+        assert f"/{node}" in nodes.stdout.splitlines(), nodes.stdout
+        assert f"└── odom [static, /{node}]" in frame("tree", "--duration", "1", env=env).stdout
+        if install_oracle() is None:  # the real ros2 lists the same topics and names the same node
+            wait_for(lambda: "/tf_static" in ros2("topic", "list", env=env).stdout.splitlines())
+            ros2_s_own = {"/parameter_events", "/rosout"}  # its daemon's node's (roc lists none of its own)
+            assert [t for t in ros2("topic", "list", env=env).stdout.splitlines() if t not in ros2_s_own] == \
+                listed.stdout.splitlines()
+            assert f"Node name: {node}\n" in ros2("topic", "info", "/tf_static", "-v", env=env).stdout
+    finally:
+        stop_process(pub)
+        stop_daemon(env)
 
 
 def test_pub_reaches_a_real_subscriber_and_ctrl_c_stops_it(sourced) -> None:

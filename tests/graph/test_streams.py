@@ -111,6 +111,23 @@ def test_pub_reaches_a_real_subscriber(graph, daemon: bool) -> None:
     assert _received(listener, 3) == [twist] * 3
 
 
+@pytest.mark.parametrize("name", [None, "my_pub"], ids=["default-name", "named"])
+def test_pub_publishes_from_a_node_named_for_it_that_roc_lists(graph, name: str | None) -> None:
+    """Through the daemon, on a node of its own (issue 51: on the daemon's hidden node, roc's lists left the
+    topic out): roc_topic_pub_<pid>, or the name -n gives, as ros2 topic pub -n."""
+    env, _ = graph
+    pub = subprocess.Popen([str(BIN / "roc"), "topic", "pub", "/named", "std_msgs/msg/String", "{data: hi}", "-r", "5",
+                            *(["-n", name] if name else [])], env=env, stdout=subprocess.PIPE,
+                           stderr=subprocess.DEVNULL, text=True)
+    try:
+        assert read_line(pub) == "publisher: beginning loop\n"
+        info = roc("topic", "info", "/named", "-v", env=env)
+        assert info.returncode == 0, info.stderr
+        assert f"Node name: {name or f'roc_topic_pub_{pub.pid}'}\n" in info.stdout, info.stdout
+    finally:
+        stop_process(pub)
+
+
 def test_pub_checks_values_before_waiting(graph) -> None:
     env, _ = graph
     started = time.monotonic()
@@ -124,6 +141,9 @@ def test_pub_checks_values_before_waiting(graph) -> None:
     assert timed_out.stdout == "Waiting for at least 1 matching subscription(s)...\n"
     assert timed_out.stderr == ("roc: error: Timed out waiting for subscribers: Expected 1 subscribers but only "
                                 "got 0 subscribers\n")
+    badly_named = roc("topic", "pub", "--once", "-n", "my-pub", "/nobody", "std_msgs/msg/String", env=env)
+    assert (badly_named.returncode, badly_named.stdout) == (2, "")
+    assert badly_named.stderr.startswith("roc: error: --node-name: 'my-pub' is not a node name")
 
 
 def test_ctrl_c_leaves_no_subscription_in_the_daemon(graph) -> None:

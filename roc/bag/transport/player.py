@@ -28,6 +28,7 @@ from roc.bag.transport.ros_qos import profile
 from roc.errors import RocError
 from roc.render import plural
 from roc.ros.graph import Graph
+from roc.ros.protocol import task_node_name
 from roc.ros.types import UnknownTypeError, message_class
 
 SPIN_NS = 100_000  # the last 0.1 ms before a message is due is waited without sleeping (sleep overshoots)
@@ -223,8 +224,10 @@ class Player:
         published: dict[str, int] = {}
         lateness: list[int] = []
         with Bag(options.bag, options.storage) as bag:
-            # the remappings are the node's, as rosbag2 passes them to its player: to its topics and /clock
-            graph = Graph(arguments=["--ros-args", *(word for rule in options.remaps for word in ("--remap", rule))])
+            # the remappings are the node's, as rosbag2 passes them to its player: to its topics and /clock;
+            # a node named for what it does (rosbag2's is rosbag2_player), listed as any other
+            remaps = [word for rule in options.remaps for word in ("--remap", rule)]
+            graph = Graph(task_node_name("bag_play"), arguments=["--ros-args", *remaps])
             try:
                 publishers, skipped = self._publishers(graph, bag)
                 if not publishers:

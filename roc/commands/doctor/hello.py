@@ -16,6 +16,7 @@ from roc.doctor.network import DEFAULT_GROUP, DEFAULT_PORT, receiver, sender
 from roc.errors import UsageError
 from roc.render import print_json_line, print_text
 from roc.ros.client import stream
+from roc.ros.protocol import task_node_name
 
 STRING = "std_msgs/msg/String"
 QOS = {"profile": "system_default"}
@@ -115,7 +116,8 @@ def run(args: argparse.Namespace) -> int:
     for worker in workers:
         worker.start()
     params = {"topic": args.topic, "type": STRING, "data": encode(message_class(STRING)(data=text)), "qos": QOS,
-              "rate": 1.0 / args.emit_period, "times": 1 if args.once else 0, "keep_alive": args.emit_period}
+              "rate": 1.0 / args.emit_period, "times": 1 if args.once else 0, "keep_alive": args.emit_period,
+              "node": task_node_name("doctor_hello")}
     printed = time.monotonic()
     try:
         for event in stream("publish", params, use_daemon=not args.no_daemon, heartbeats=True):

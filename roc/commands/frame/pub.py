@@ -12,6 +12,7 @@ from roc.errors import UsageError
 from roc.frames.transform import Transform, normalized
 from roc.render import print_text
 from roc.ros.client import stream
+from roc.ros.protocol import task_node_name
 from roc.ros.types import TF_TYPE, message_class
 
 
@@ -81,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
               "qos": {"profile": "default", "depth": 1 if static else 100,
                       **({"durability": "transient_local"} if static else {})},
               "rate": args.rate, "times": 1 if static else 0, "wait": 0, "max_wait": None,
-              "keep_alive": None if static else 0.1}
+              "keep_alive": None if static else 0.1, "node": task_node_name("frame_pub")}
     local = {} if static else {"prepare": lambda: serialize(_stamped(tf_message))}  # stamped anew each time
     deadline = time.monotonic() + args.duration if args.duration is not None else None
     where = "/tf_static" if static else f"/tf at {args.rate:g} Hz"

@@ -4,6 +4,7 @@ field, before anything waits or is published."""
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 import time
 from pathlib import Path
@@ -14,6 +15,7 @@ from roc.errors import UsageError
 from roc.render import print_json_line, print_text
 from roc.ros.client import stream
 from roc.ros.messages import fill_message, parse_values, value_to_data
+from roc.ros.protocol import task_node_name
 from roc.ros.types import message_class
 
 WAITING_LINES = 5  # ros2's waiting line, once a second, before roc says once how to stop waiting
@@ -51,7 +53,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="fail when the subscriptions have not matched within this time (default: wait)")
     parser.add_argument("--keep-alive", type=float, default=0.1, metavar="SECONDS",
                         help="keep the publisher this long after the last message (default: 0.1)")
-    parser.add_argument("-n", "--node-name", help="publish from a node of this name (runs without the daemon)")
+    parser.add_argument("-n", "--node-name", help="publish from a node of this name (default: roc_topic_pub_<pid>)")
     add_qos_arguments(parser, "default", "publish")
     add_graph_arguments(parser)
 
@@ -70,6 +72,9 @@ def _values_text(args: argparse.Namespace) -> tuple[str | None, str]:
 def run(args: argparse.Namespace) -> int:
     if args.rate <= 0:
         raise UsageError(f"--rate: must be above 0 Hz, got {args.rate:g}")
+    if args.node_name is not None and not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", args.node_name):
+        raise UsageError(f"--node-name: {args.node_name!r} is not a node name (letters, digits and '_', "
+                         "not starting with a digit)")
     if args.print_every < 0 or args.times < 0:
         raise UsageError("--print and --times take a number of 0 or more")
     from roc.ros.cdr import encode
@@ -82,12 +87,11 @@ def run(args: argparse.Namespace) -> int:
     params = {"topic": args.topic_name, "type": args.message_type, "data": encode(message),
               "qos": qos_options(args), "rate": args.rate, "times": times,
               "wait": wait if wait is not None else 1 if times else 0,
-              "max_wait": args.max_wait_time_secs, "keep_alive": args.keep_alive}
+              "max_wait": args.max_wait_time_secs, "keep_alive": args.keep_alive,
+              "node": args.node_name or task_node_name("topic_pub")}
     local: dict[str, Any] = {}
     if stamps:  # header: auto / stamp: now, set anew before each message: published from this process
         local["prepare"] = lambda: _restamp(message, stamps)
-    if args.node_name:
-        local["node_name"] = args.node_name
     waited = 0
     for event in stream("publish", params, use_daemon=not args.no_daemon and not local, **local):
         kind = event["event"]
