@@ -12,7 +12,8 @@ exited or was killed: the kernel closes it either way), the guard stops:
   everything it starts, so grandchildren and processes that left their group are found too),
 - and every descendant of those,
 
-with SIGTERM, then SIGKILL for what still runs after the grace period. Linux only (``/proc``); the
+with SIGTERM, sent again every RESEND_SECONDS to what still runs, then SIGKILL for what still runs after
+the grace period. Linux only (``/proc``); the
 standard library only, so that it starts in milliseconds. roc runs the same ``sweep`` itself when it
 ends normally, so nothing is left even before the guard notices.
 """
@@ -27,6 +28,11 @@ from dataclasses import dataclass
 
 TOKEN_VARIABLE = "ROC_LAUNCH_ID"
 GRACE_SECONDS = 5.0
+# SIGTERM goes again this often during the grace. rclpy's handler (7.x, Jazzy) wakes the node's executor and
+# only then shuts its context down, and that shutdown wakes nothing: an executor that looked at its
+# context in between waits again, until a timer or a message wakes it, and a node with neither slept
+# until SIGKILL. A second SIGTERM wakes it to a context already shut down, and it ends.
+RESEND_SECONDS = 0.5
 
 
 @dataclass
@@ -101,13 +107,18 @@ def _alive(pids: list[int]) -> list[int]:
 
 def sweep(token: str, recorded: dict[int, int] | None = None, groups: set[int] | None = None,
           grace: float = GRACE_SECONDS) -> list[int]:
-    """Stop every process of the run (SIGTERM, then SIGKILL after ``grace``); the PIDs it found."""
+    """Stop every process of the run (SIGTERM, again every RESEND_SECONDS, then SIGKILL after ``grace``);
+    the PIDs it found."""
     found = targets(token, recorded or {}, groups or set())
     if not found:
         return found
     _signal_all(found, signal.SIGTERM)
     deadline = time.monotonic() + grace
-    while _alive(found) and time.monotonic() < deadline:
+    resend = time.monotonic() + RESEND_SECONDS
+    while (alive := _alive(found)) and time.monotonic() < deadline:
+        if time.monotonic() >= resend:
+            _signal_all(alive, signal.SIGTERM)
+            resend += RESEND_SECONDS
         time.sleep(0.05)
     _signal_all(_alive(found), signal.SIGKILL)
     return found

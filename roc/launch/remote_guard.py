@@ -11,7 +11,7 @@ settings, its output going straight into the SSH session. Then it stays tied to 
 - the end of its standard input (roc, its ssh client or the connection closed), or SILENCE_SECONDS
   without a byte (roc frozen, its host suspended, the network cut: the connection itself may take hours
   to time out), stops the process, its group, every process carrying its token and their descendants
-  (guard.sweep: SIGTERM, then SIGKILL after GRACE_SECONDS). So a remote process outlives a failure
+  (guard.sweep: SIGTERM, repeated, then SIGKILL after GRACE_SECONDS). So a remote process outlives a failure
   by at most SILENCE_SECONDS + GRACE_SECONDS.
 
 What it tells roc goes to its standard error as lines ``roc-remote JSON``: ``started`` (pid, command line),

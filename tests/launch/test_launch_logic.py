@@ -143,6 +143,36 @@ def test_closing_the_guard_stops_what_is_left_and_nothing_else() -> None:
             process.wait()
 
 
+# Ends on its second SIGTERM only, as an rclpy node whose executor woke before rclpy's signal handler had shut
+# its context down, and that no timer or message wakes again (roc.launch.guard.RESEND_SECONDS).
+ENDS_ON_A_SECOND_SIGTERM = """
+import signal, sys, time
+received = []
+signal.signal(signal.SIGTERM, lambda *_: sys.exit(0) if received else received.append(1))
+print("ready", flush=True)
+while True:
+    time.sleep(0.05)
+"""
+
+
+def test_the_guard_ends_a_node_that_misses_its_first_sigterm_well_within_the_grace() -> None:
+    """Issue 51: after kill -9 of roc launch, an rclpy node sometimes took the whole grace and its SIGKILL."""
+    from roc.launch.guard import GRACE_SECONDS, Guard
+
+    guard = Guard()
+    node = subprocess.Popen([sys.executable, "-c", ENDS_ON_A_SECOND_SIGTERM], stdout=subprocess.PIPE, text=True,
+                            env=guard.environment(dict(os.environ)))
+    try:
+        assert node.stdout is not None and node.stdout.readline() == "ready\n"
+        started = time.monotonic()
+        assert guard.close() == [node.pid]
+        assert node.wait(timeout=1) == 0  # its own end, not the grace's SIGKILL
+        assert time.monotonic() - started < GRACE_SECONDS / 2
+    finally:
+        node.kill()
+        node.wait()
+
+
 class Lines:
     def __init__(self) -> None:
         self.lines: list[str] = []
