@@ -197,3 +197,15 @@ def test_the_manual_says_what_a_newcomer_needs_to_know() -> None:
     for script in sorted((REPO / "bench").glob("*.py")):
         assert f"## {script.name}" in bench or f"`{script.name}`" in bench, script.name
     assert "## incremental_bench.py" in bench
+
+
+def test_the_configuration_page_names_every_table_roc_toml_may_hold() -> None:
+    """Issue 51: the list of roc.toml's tables left out the launch systems' tables."""
+    from roc.launch.system import HOST_KEYS, PROCESS_KEYS, SYSTEM_KEYS
+
+    listed = " ".join((REPO / "docs" / "configuration.md").read_text().split("## See the effective")[0].split())
+    for table in ("[defaults]", "[profile.NAME]", "[profile.NAME.VERB]", "[package.NAME]", "[check]",
+                  "[launch.NAME]", "[[launch.NAME.process]]", '[launch.NAME.hosts."H"]'):
+        assert f"`{table}`" in listed, table
+    for key in (*(k for k in SYSTEM_KEYS if k not in ("process", "hosts")), *PROCESS_KEYS, *HOST_KEYS):
+        assert f"`{key}`" in listed, key
