@@ -4,6 +4,9 @@
 #   bash scripts/setup.sh --distro kilted   .venv-kilted  ROS 2 Kilted
 #   bash scripts/setup.sh --with-cpp        .venv, then the C++ stack (rclcpp from source) built by roc on
 #                                           it in .cpp-stack/ (scripts/setup_cpp.sh)
+#   bash scripts/setup.sh --with-cyclonedds .venv, then Debian's cyclonedds-dev (apt-get, as root) and
+#                                           rmw_cyclonedds built by roc on it in .rmw-stack/
+#                                           (scripts/setup_rmw.sh)
 # Each is
 #   - a venv made with python3 -m venv (or $PYTHON -m venv),
 #   - roc installed editable with its test extra (pytest, pytest-xdist, colcon as test oracle),
@@ -34,12 +37,14 @@ die() { printf 'setup: error: %s\n' "$*" >&2; exit 1; }
 
 DISTRO=jazzy
 WITH_CPP=0
-USAGE="usage: bash scripts/setup.sh [--distro jazzy|kilted] [--with-cpp]"
+WITH_CYCLONEDDS=0
+USAGE="usage: bash scripts/setup.sh [--distro jazzy|kilted] [--with-cpp] [--with-cyclonedds]"
 while [ "$#" -gt 0 ]; do
     case "$1" in
         --distro) DISTRO="${2:-}"; shift 2 || die "--distro needs a name (jazzy or kilted)" ;;
         --distro=*) DISTRO="${1#--distro=}"; shift ;;
         --with-cpp) WITH_CPP=1; shift ;;
+        --with-cyclonedds) WITH_CYCLONEDDS=1; shift ;;
         *) die "unknown argument '$1' ($USAGE)" ;;
     esac
 done
@@ -49,6 +54,8 @@ case "$DISTRO" in
 esac
 [ "$WITH_CPP" = 0 ] || [ "$DISTRO" = jazzy ] \
     || die "--with-cpp builds the Jazzy sources of rclcpp: use it without --distro $DISTRO"
+[ "$WITH_CYCLONEDDS" = 0 ] || [ "$DISTRO" = jazzy ] \
+    || die "--with-cyclonedds builds the Jazzy sources of rmw_cyclonedds: use it without --distro $DISTRO"
 REQUIREMENTS="$ROOT/requirements/ros-$DISTRO.txt"
 # Jazzy, the default, in .venv; any other distribution in a venv of its own
 if [ "$DISTRO" = jazzy ]; then VENV="$ROOT/.venv"; else VENV="$ROOT/.venv-$DISTRO"; fi
@@ -110,6 +117,12 @@ setup_test_tools() {
     fi
 }
 
+# The stacks built on the venv that were asked for (--with-cpp, --with-cyclonedds).
+build_stacks() {
+    [ "$WITH_CPP" = 0 ] || bash "$ROOT/scripts/setup_cpp.sh"
+    [ "$WITH_CYCLONEDDS" = 0 ] || bash "$ROOT/scripts/setup_rmw.sh"
+}
+
 # ---- quick path -------------------------------------------------------------------------
 if [ "${ROC_SETUP_FORCE:-0}" != 1 ] && [ -f "$STAMP" ] && venv_ok \
         && [ "$(cat -- "$STAMP")" = "$(want_stamp)" ]; then
@@ -118,7 +131,7 @@ if [ "${ROC_SETUP_FORCE:-0}" != 1 ] && [ -f "$STAMP" ] && venv_ok \
     "$VPY" -m compileall -q "$ROOT/roc" >/dev/null  # only what changed since the last run
     setup_test_tools quiet
     say "environment up to date ($VENV); set ROC_SETUP_FORCE=1 to redo it"
-    [ "$WITH_CPP" = 0 ] || exec bash "$ROOT/scripts/setup_cpp.sh"
+    build_stacks
     exit 0
 fi
 
@@ -185,4 +198,4 @@ fi
 
 want_stamp >"$STAMP"
 say "done in $((SECONDS - start)) s: ROS 2 $DISTRO; run roc as $VENV/bin/roc (or 'source ${VENV#"$ROOT"/}/bin/activate')"
-[ "$WITH_CPP" = 0 ] || exec bash "$ROOT/scripts/setup_cpp.sh"
+build_stacks

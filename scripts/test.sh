@@ -7,6 +7,9 @@
 # --with-cpp (first) builds the C++ stack (scripts/setup.sh --with-cpp), then runs the C++ suite (tests
 # marked cpp); the whole suite runs them too once the stack is built, and skips them while it is not:
 #   bash scripts/test.sh --with-cpp
+# --rmw cyclonedds|fastrtps (first) runs the middleware suite (tests marked rmw) with RMW_IMPLEMENTATION
+# naming that middleware; cyclonedds first builds rmw_cyclonedds (scripts/setup.sh --with-cyclonedds):
+#   bash scripts/test.sh --rmw cyclonedds
 # (tests/conftest.py: on a distribution other than Jazzy only the tests marked distro run).
 set -euo pipefail
 
@@ -14,16 +17,25 @@ ROOT="$(cd -- "$(dirname -- "${BASH_SOURCE[0]}")/.." && pwd -P)"
 cd "$ROOT"
 
 distro=jazzy
-suite=()  # --with-cpp: the C++ suite, the tests marked cpp
+suite=()  # --with-cpp: the C++ suite, the tests marked cpp; --rmw: the middleware suite, the tests marked rmw
+marker=
 case "${1:-}" in
     --distro) distro="${2:?test: --distro needs a name (jazzy or kilted)}"; shift 2 ;;
     --distro=*) distro="${1#--distro=}"; shift ;;
-    --with-cpp) suite=(--with-cpp); shift ;;
+    --with-cpp) suite=(--with-cpp); marker=cpp; shift ;;
+    --rmw)
+        case "${2:-}" in
+            cyclonedds) suite=(--with-cyclonedds) ;;
+            fastrtps) ;;
+            *) echo "test: error: --rmw needs a middleware: cyclonedds or fastrtps" >&2; exit 2 ;;
+        esac
+        export RMW_IMPLEMENTATION="rmw_${2}_cpp"
+        marker=rmw; shift 2 ;;
 esac
 if [ "$distro" = jazzy ]; then venv="$ROOT/.venv"; else venv="$ROOT/.venv-$distro"; fi
 
 bash "$ROOT/scripts/setup.sh" --distro "$distro" "${suite[@]}"
-[ "${#suite[@]}" -eq 0 ] || set -- -m cpp "$@"
+[ -z "$marker" ] || set -- -m "$marker" "$@"
 
 rc=0
 # loadgroup: tests marked xdist_group("busy_or_timing") share one worker, so the bridge tests' busy

@@ -3,8 +3,8 @@
 - The suite's processes stop on SIGINT (the tests' Ctrl+C) even when the suite was started with SIGINT
   ignored, as a shell does for a command it runs in the background (``bash scripts/test.sh &``): an
   ignored signal stays ignored in every child, a handled one is reset to its default.
-- Tests skipped because an oracle is missing (tests/helpers/oracles.py), or the C++ stack they need is not
-  built (tests/helpers/cpp.py, the tests marked ``cpp``), are summed up at the end of the run, one line per
+- Tests skipped because an oracle is missing (tests/helpers/oracles.py), or the C++ stack or rmw_cyclonedds
+  they need is not built (tests/helpers/cpp.py, the tests marked ``cpp``; tests/helpers/rmw.py), are summed up at the end of the run, one line per
   reason, so that a checkout without ``../shared`` or the stack says what it did not test.
 - The suite's own process writes byte-code (see below); the processes it starts follow the environment.
 - The whole suite runs on Jazzy (.venv). On another distribution (``bash scripts/test.sh --distro
@@ -20,6 +20,7 @@ from collections import Counter
 import pytest
 from helpers.build import share_compiles
 from helpers.cpp import MISSING as MISSING_CPP_STACK
+from helpers.rmw import MISSING as MISSING_CYCLONEDDS
 
 from roc import distribution
 
@@ -61,7 +62,7 @@ def pytest_report_header(config) -> str:
 def pytest_terminal_summary(terminalreporter) -> None:
     reasons = Counter(_skip_reason(r) for r in terminalreporter.stats.get("skipped", []))
     missing = sorted(((reason, count) for reason, count in reasons.items()
-                      if reason.startswith(("oracle ", MISSING_CPP_STACK))),
+                      if reason.startswith(("oracle ", MISSING_CPP_STACK, MISSING_CYCLONEDDS))),
                      key=lambda item: (-item[1], item[0]))  # the most skipped first
     if missing:
         terminalreporter.section("missing oracles and stacks")

@@ -9,6 +9,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from helpers.rmw import middleware_prefixes
 from roc import distribution
 
 REPO = Path(__file__).resolve().parents[2]
@@ -25,9 +26,10 @@ ENV_VARIABLES = ("AMENT_PREFIX_PATH", "CMAKE_PREFIX_PATH", "PYTHONPATH", "PATH",
 
 
 def ros_env(**extra: str) -> dict[str, str]:
-    """The environment of a developer who has ROS (the venv's wheels) as underlay."""
+    """The environment of a developer who has ROS (the venv's wheels, and the middleware suite's RMW) as
+    underlay."""
     env = {k: v for k, v in os.environ.items() if k not in ("COLCON_PREFIX_PATH", "AMENT_PREFIX_PATH")}
-    env["AMENT_PREFIX_PATH"] = sys.prefix
+    env["AMENT_PREFIX_PATH"] = os.pathsep.join([*middleware_prefixes(), sys.prefix])
     env["PATH"] = f"{BIN}{os.pathsep}{env.get('PATH', '/usr/bin:/bin')}"
     env.update(extra)
     return env

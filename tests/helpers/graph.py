@@ -15,6 +15,7 @@ from pathlib import Path
 from helpers.build import BIN, DISTRO, REQUIREMENTS, ros_domain_id, stop_process
 from helpers.build import roc as roc_build
 from helpers.oracles import SHARED, require_oracle
+from helpers.rmw import middleware_prefixes
 
 NODE_SCRIPT = Path(__file__).resolve().parents[1] / "nodes" / "graph_node.py"
 # the real ros2 CLI, in a venv of the tests' distribution's wheels (Jazzy's keeps its first name)
@@ -39,12 +40,12 @@ DEMO_GRAPH = [
 
 
 def graph_env(slot: int, runtime_dir: Path, **extra: str) -> dict[str, str]:
-    """A private ROS domain (the test file's slot, see helpers.build.ros_domain_id), localhost discovery
-    and a private daemon directory."""
+    """A private ROS domain (the test file's slot, see helpers.build.ros_domain_id), localhost discovery,
+    a private daemon directory and the middleware suite's RMW (helpers.rmw)."""
     env = dict(os.environ)
     env.pop("ROS_LOCALHOST_ONLY", None)
     env.update(ROS_DOMAIN_ID=ros_domain_id(slot), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
-               XDG_RUNTIME_DIR=str(runtime_dir), AMENT_PREFIX_PATH=f"{ORACLE_VENV}{os.pathsep}{sys.prefix}",
+               XDG_RUNTIME_DIR=str(runtime_dir), AMENT_PREFIX_PATH=os.pathsep.join([*middleware_prefixes(), str(ORACLE_VENV), sys.prefix]),
                PATH=f"{BIN}{os.pathsep}{env.get('PATH', '/usr/bin:/bin')}")
     env.update(extra)
     return env

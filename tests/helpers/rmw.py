@@ -1,0 +1,52 @@
+"""The middleware suite (tests marked ``rmw``): ``bash scripts/test.sh --rmw cyclonedds`` runs them with
+RMW_IMPLEMENTATION=rmw_cyclonedds_cpp, on the rmw_cyclonedds that ``bash scripts/setup.sh
+--with-cyclonedds`` builds with roc in .rmw-stack/; the whole suite runs them on Fast DDS, the wheels' own.
+A test that needs rmw_cyclonedds (the suite's, or a Cyclone process beside Fast DDS ones) calls
+``require_cyclonedds``: without the build it is skipped with the reason ``rmw_cyclonedds is not built:
+...`` (conftest.py sums these up), except in CI, which builds it: there it fails."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from helpers.oracles import REPO, in_ci
+
+STACK = REPO / ".rmw-stack"
+CYCLONEDDS = "rmw_cyclonedds_cpp"
+FASTRTPS = "rmw_fastrtps_cpp"
+CYCLONEDDS_PREFIX = STACK / "install" / CYCLONEDDS
+SETUP_COMMAND = "bash scripts/setup.sh --with-cyclonedds"
+MISSING = f"rmw_cyclonedds is not built: run {SETUP_COMMAND}"
+
+
+def suite_middleware() -> str:
+    """The RMW this run's graph tests use: RMW_IMPLEMENTATION's (test.sh --rmw), Fast DDS without it."""
+    return os.environ.get("RMW_IMPLEMENTATION") or FASTRTPS
+
+
+def require_cyclonedds() -> Path:
+    """rmw_cyclonedds' install prefix; skips the test (fails it in CI) when it is not built."""
+    if not (STACK / "ready").is_file():
+        if in_ci():
+            pytest.fail(f"{MISSING} (CI builds it before the middleware suite)", pytrace=False)
+        pytest.skip(MISSING)
+    return CYCLONEDDS_PREFIX
+
+
+def middleware_prefixes(middleware: str | None = None) -> list[str]:
+    """The install prefixes, before the wheels', a process needs to find ``middleware`` (default the
+    suite's) in the ament index: rmw_cyclonedds' prefix for Cyclone, none for the wheels' Fast DDS."""
+    return [str(CYCLONEDDS_PREFIX)] if (middleware or suite_middleware()) == CYCLONEDDS else []
+
+
+def on_middleware(env: dict[str, str], middleware: str) -> dict[str, str]:
+    """``env`` (with the wheels as underlay, helpers.build.ros_env) for a process on ``middleware``."""
+    if middleware == CYCLONEDDS:
+        require_cyclonedds()
+    prefixes = [*middleware_prefixes(middleware),
+                *(entry for entry in env.get("AMENT_PREFIX_PATH", "").split(os.pathsep)
+                  if entry and entry != str(CYCLONEDDS_PREFIX))]
+    return {**env, "RMW_IMPLEMENTATION": middleware, "AMENT_PREFIX_PATH": os.pathsep.join(prefixes)}
