@@ -37,7 +37,9 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
 sys.path.insert(0, str(HERE.parent / "tests"))
+sys.path.insert(0, str(HERE))
 
+from cluster_sim import critical_path, from_workspace  # noqa: E402
 from helpers.cluster import start_scheduler, start_worker, stop_all, wait_for_workers  # noqa: E402
 from helpers.remote_servers import webdav  # noqa: E402
 
@@ -175,6 +177,9 @@ def main(argv: list[str] | None = None) -> int:
         each("cold", lambda ws, run: clean(ws))
     if "cold" in figures:
         compare_installs(spaces["roc"], spaces["colcon"])
+        graph, durations = from_workspace(spaces["roc"])
+        print(f"roc's cold build: {len(graph)} packages, {sum(durations.values()):.0f} s of package time summed, "
+              f"critical path {critical_path(graph, durations):.0f} s, wall {figures['cold']['roc']:.0f} s")
     if wants & {"noop", "edit"}:
         each("noop", lambda ws, run: None)
     if "edit" in wants:
