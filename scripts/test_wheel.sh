@@ -72,7 +72,8 @@ wanted = ["roc/_version.py", "roc/create/templates/python/node.py.j2", "roc/crea
 missing = [name for name in wanted if name not in names]
 missing += [] if any(n.endswith(".data/scripts/roc") for n in names) else ["the roc script"]
 missing += [] if any(n.endswith("/licenses/LICENSE") for n in names) else ["LICENSE"]
-leaked = sorted({n.split("/")[0] for n in names} - {"roc"} - {n.split("/")[0] for n in names if ".dist-info" in n or ".data" in n})
+leaked = sorted({top for top in (n.split("/")[0] for n in names)
+                 if top != "roc" and not top.endswith((".dist-info", ".data"))})
 print("missing:", missing, "not roc's:", leaked)
 sys.exit(1 if missing or leaked else 0)
 EOF
@@ -119,10 +120,9 @@ EOF
     grep -q "Hello from py_pkg: 3" <<<"$out"
 }
 tui_first_screen() {
-    command -v tmux >/dev/null || { echo "tmux is not installed"; return 0; }
-    local socket="$WORK/tmux-$scenario.sock" screen="" i
+    local socket="$WORK/tmux-$scenario.sock" screen=""
     tmux -S "$socket" new-session -d -x 120 -y 35 -s roc "env TERM=xterm-256color roc tui; sleep 30"
-    for i in $(seq 1 150); do
+    for _ in $(seq 1 150); do
         screen=$(tmux -S "$socket" capture-pane -p -t roc 2>/dev/null)
         grep -q "/chatter" <<<"$screen" && grep -q "/talker" <<<"$screen" && break
         sleep 0.2
@@ -159,7 +159,11 @@ smoke() {
     check "roc topic echo" bash -c "timeout 30 roc topic echo /chatter --once | grep \"^data: 'Hello from py_pkg: \""
     check "roc bag record" bash -c "timeout -s INT 4 roc bag record -o bag /chatter; [ -f bag/metadata.yaml ]"
     check "roc bag info" bash -c "roc bag info bag | grep -E 'Topic: /chatter \\| Type: std_msgs/msg/String \\| Count: [1-9]'"
-    check "roc tui first screen" tui_first_screen
+    if command -v tmux >/dev/null; then
+        check "roc tui first screen" tui_first_screen
+    else
+        say "skipped $scenario: roc tui first screen (tmux is not installed)"
+    fi
     stop_all
     roc daemon stop >/dev/null 2>&1
     if python -c 'import launch_xml' 2>/dev/null; then
