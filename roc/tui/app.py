@@ -26,6 +26,10 @@ if TYPE_CHECKING:  # builds load the engine's modules only when one starts
     from roc.tui.build_run import BuildRun, Start
 
 
+VIEW_USAGE = {"array": "array TOPIC FIELD: e.g. array /scan ranges", "scan": "scan TOPIC: e.g. scan /scan",
+              "grid": "grid TOPIC: e.g. grid /map"}
+
+
 class RocApp(App[int]):
     TITLE = "roc tui"
     BINDINGS = [
@@ -152,6 +156,13 @@ class RocApp(App[int]):
             from roc.tui.launch_screen import LaunchScreen
 
             return LaunchScreen()
+        if kind in ("array", "scan", "grid"):
+            from roc.tui.image_screen import SensorScreen
+
+            words = name.split()
+            if len(words) != (2 if kind == "array" else 1):
+                raise UsageError(VIEW_USAGE[kind])
+            return SensorScreen(kind, *words)
         if kind == "image":
             from roc.tui.image_screen import ImageScreen
 

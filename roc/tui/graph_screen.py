@@ -27,11 +27,11 @@ from roc.tui.widgets import ListTable, follow, host
 
 REFRESH_SECONDS = 1.0
 # the topics' columns whose values change every second, at the widths of their longest values
-WIDTHS = {"topics": {"pub": 3, "sub": 3, "rate": 9, "bandwidth": 11}, "nodes": {"cpu": 6, "mem": 5}}
+WIDTHS = {"topics": {"pub": 3, "sub": 3, "rate": 9, "bandwidth": 11}, "nodes": {"cpu": 6, "mem": 5, "pid": 7}}
 # list -> (columns, marks, the columns cut to fit the screen); nodes and topics side by side in the first
 # tab, the others a tab each
 LISTS = {
-    "nodes": (("node", "cpu", "mem"), True, ("node",)),
+    "nodes": (("node", "cpu", "mem", "pid"), True, ("node",)),
     "topics": (("topic", "pub", "sub", "rate", "bandwidth", "type"), True, ("topic", "type")),
     "services": (("service", "type"), False, ("service", "type")),
     "actions": (("action", "type"), False, ("action", "type")),
@@ -71,6 +71,8 @@ class GraphScreen(Screen):
         Binding("b", "build", "build the package under the cursor and what it needs (Packages)", show=False),
         Binding("B", "build(True)", "build the whole workspace (Packages)", show=False),
         Binding("H", "toggle_hidden", "show hidden names", show=False),
+        Binding("s", "sort", "sort the list by its next column (numbers largest first)", show=False),
+        Binding("S", "sort_reversed", "sort the other way", show=False),
     ]
     DEFAULT_CSS = """
     GraphScreen { overflow: hidden; }
@@ -82,7 +84,7 @@ class GraphScreen(Screen):
     GraphScreen #tabs { height: 1fr; }
     GraphScreen #system { layout: horizontal; height: 1fr; }
     GraphScreen #system.narrow { layout: vertical; }
-    GraphScreen #system #nodes-table { width: 1fr; min-width: 36; max-width: 64; }
+    GraphScreen #system #nodes-table { width: 1fr; min-width: 44; max-width: 72; }
     GraphScreen #system #topics-table { width: 2fr; }
     GraphScreen #system.narrow #nodes-table { width: 1fr; max-width: 100%; height: 2fr; }
     GraphScreen #system.narrow #topics-table { width: 1fr; height: 3fr; }
@@ -371,3 +373,11 @@ class GraphScreen(Screen):
         self.hidden = not self.hidden
         if self.snapshot is not None:
             self.show_snapshot(self.snapshot)
+
+    def action_sort(self) -> None:
+        self.table(self.active_tab()).sort_next()
+        self.show_again()
+
+    def action_sort_reversed(self) -> None:
+        self.table(self.active_tab()).sort_reversed()
+        self.show_again()

@@ -125,3 +125,25 @@ def half_blocks(image, columns: int, rows: int) -> list[Text]:
             line.append("▀", style)
         lines.append(line)
     return lines
+
+
+GRID = "nav_msgs/msg/OccupancyGrid"
+
+
+def grid_image(grid: dict, columns: int, rows: int):
+    """A decoded nav_msgs/OccupancyGrid as a Pillow image for ``half_blocks`` in ``columns`` x ``rows``
+    cells: free white, occupied black (the likelier, the darker), unknown grey, north up (the grid's
+    first row is its bottom). Shrunk to the cells, a cell takes its darkest cell of the map, so that a
+    wall one cell thick stays drawn."""
+    from PIL import Image, ImageFilter
+
+    info = grid["info"]
+    width, height = info["width"], info["height"]
+    if not width or not height or len(grid["data"]) < width * height:
+        raise RocError(f"an empty or short grid ({width} x {height}, {len(grid['data'])} cells)")
+    shades = bytes(128 if value < 0 else 255 - min(value, 100) * 255 // 100 for value in grid["data"][:width * height])
+    image = Image.frombytes("L", (width, height), shades).transpose(Image.Transpose.FLIP_TOP_BOTTOM)
+    shrink = max(width / max(1, columns), height / (2 * max(1, rows)))
+    if shrink > 1.5:
+        image = image.filter(ImageFilter.MinFilter(2 * int(shrink / 2) + 1))
+    return image

@@ -15,6 +15,7 @@ SCREENS = (
     ("logs", "roc.tui.logs_screen", "LogsScreen"),
     ("plot", "roc.tui.plot_screen", "PlotScreen"),
     ("image", "roc.tui.image_screen", "ImageScreen"),
+    ("array, scan, grid", "roc.tui.image_screen", "SensorScreen"),
     ("diagnostics", "roc.tui.diagnostics_screen", "DiagnosticsScreen"),
     ("service, action", "roc.tui.call_screens", "ActionScreen"),
     ("publish", "roc.tui.call_screens", "PublishScreen"),

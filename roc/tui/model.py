@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 from roc.ros.present import is_hidden
 from roc.ros.rates import Window, samples, size_text
@@ -64,6 +64,26 @@ def cut_widths(room: int, widths: list[int]) -> int | None:
             return max(SHORTEST, (room - kept) // left)
         kept += width
     return None
+
+
+UNITS = {"": 1.0, "k": 1e3, "K": 1e3, "M": 1e6, "G": 1e9, "T": 1e12}
+
+
+def cell_number(text: str) -> float | None:
+    """A cell's number as the lists sort it (``12%``, ``45M``, ``2.0 Hz``, ``1.2 kHz``, ``1.50 KB/s``,
+    a pid), None for a text (``remote``, ``gone``, ``-``)."""
+    found = re.match(r"(-?\d+(?:\.\d+)?)\s*([kKMGT]?)", text)
+    return float(found.group(1)) * UNITS[found.group(2)] if found else None
+
+
+def sorted_rows(rows: list[Row], column: int, descending: bool) -> list[Row]:
+    """``rows`` by their cells of ``column``: the numbers by value, then the texts, then the empty cells
+    (a node on another host, one gone), each in the order asked for."""
+    numbers = [row for row in rows if cell_number(row.cells[column]) is not None]
+    texts = [row for row in rows if cell_number(row.cells[column]) is None and row.cells[column]]
+    empty = [row for row in rows if not row.cells[column]]
+    return (sorted(numbers, key=lambda row: cast(float, cell_number(row.cells[column])), reverse=descending)
+            + sorted(texts, key=lambda row: row.cells[column].lower(), reverse=descending) + empty)
 
 
 def shown_endpoints(endpoints: dict[str, Any]) -> dict[str, Any]:
@@ -166,15 +186,19 @@ def topic_rows(snapshot: dict[str, Any], rates: Rates, hidden: bool = False) -> 
 
 def node_rows(snapshot: dict[str, Any], hidden: bool = False, usage: dict[str, Usage] | None = None,
               gone: dict[str, float] | None = None) -> list[Row]:
-    """Each node with its process's CPU (% of a core; ``remote`` on another host) and resident memory
-    (shared by the nodes of one process); then the nodes ``gone`` (name -> when last seen)."""
+    """Each node with its process's CPU (% of a core; ``remote`` on another host), resident memory
+    (shared by the nodes of one process) and process id; then the nodes ``gone`` (name -> when last seen)."""
     names = [n["full_name"] for n in snapshot["nodes"]]
     usage = usage or {}
     rows = [Row(n["full_name"], (n["full_name"], cpu_text(usage.get(n["full_name"])),
-                                 memory_text(usage.get(n["full_name"]))),
+                                 memory_text(usage.get(n["full_name"])), pid_text(usage.get(n["full_name"]))),
                 ["duplicate name"] if names.count(n["full_name"]) > 1 else [])
             for n in visible(snapshot["nodes"], hidden)]
-    return rows + [Row(name, (name, "gone", ""), ["gone"]) for name in sorted(gone or {})]
+    return rows + [Row(name, (name, "gone", "", ""), ["gone"]) for name in sorted(gone or {})]
+
+
+def pid_text(usage: Usage | None) -> str:
+    return str(usage.pid) if usage is not None and usage.pid is not None else ""
 
 
 def typed_rows(entries: list[dict[str, Any]], hidden: bool = False) -> list[Row]:

@@ -1,5 +1,6 @@
 """The command palette (``:``): every view by name (``nodes``, ``topics``, ``logs [NODE]``, ``plot TOPIC
-FIELD...``, ``image TOPIC``, ``diagnostics``, ``frames``, ``bag PATH``, ``launch``, ``build``, ``publish TOPIC``), and
+FIELD...``, ``image TOPIC``, ``array TOPIC FIELD``, ``scan TOPIC``, ``grid TOPIC``, ``diagnostics``,
+``frames``, ``bag PATH``, ``launch``, ``build``, ``publish TOPIC``), and
 any node, topic, service or action of the graph by its name (every word typed must be part of it)."""
 
 from __future__ import annotations
@@ -20,6 +21,9 @@ VIEWS = {
     "logs": ("[NODE]", "/rosout live, filtered by level, node and text"),
     "plot": ("TOPIC FIELD [FIELD...]", "numeric fields against time"),
     "image": ("TOPIC", "an image topic drawn in the terminal (sensor_msgs Image, CompressedImage)"),
+    "array": ("TOPIC FIELD", "a numeric array of the newest message against its index (LaserScan ranges)"),
+    "scan": ("TOPIC", "a LaserScan's returns around the sensor"),
+    "grid": ("TOPIC", "an occupancy grid (nav_msgs OccupancyGrid), north up"),
     "diagnostics": ("", "/diagnostics by hardware id and name, worst first"),
     "frames": ("", "the live tf tree"),
     "publish": ("TOPIC", "publish a message on a topic, once or at a rate"),
@@ -27,7 +31,7 @@ VIEWS = {
     "launch": ("", "the roc launch runs of this host: processes, output, restart, stop"),
     "build": ("", "roc work build of the workspace, shown live"),
 }
-NEEDS_WORDS = {"plot", "image", "publish", "bag"}
+NEEDS_WORDS = {"plot", "image", "array", "scan", "grid", "publish", "bag"}
 FIRST = 1e9  # the score of a view named with its words: above any of Textual's fuzzy matcher (up to tens)
 
 

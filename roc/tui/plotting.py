@@ -1,12 +1,14 @@
 """What a plot shows, as plain data: the samples of each series (a numeric field of a topic) against
-time, the window's points thinned to what the screen can draw, and the samples written as CSV. No
-Textual here."""
+time, the window's points thinned to what the screen can draw, and the samples written as CSV; a
+numeric array of a message against its index, and a LaserScan's returns as points around the sensor.
+No Textual here."""
 
 from __future__ import annotations
 
 import bisect
 import csv
 import io
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -89,3 +91,42 @@ def csv_text(series: list[Series], start: float = float("-inf"), end: float = fl
         writer.writerow([f"{when:.9f}", *(repr(rows[when][one.label]) if one.label in rows[when] else ""
                                           for one in series)])
     return out.getvalue()
+
+
+def array_at(message: Any, path: str) -> list[float] | None:
+    """The numbers of the array at dotted ``path`` of a decoded message (``ranges``,
+    ``position``), None when that is no array of numbers."""
+    value = message
+    for name in path.split("."):
+        if not isinstance(value, dict) or name not in value:
+            return None
+        value = value[name]
+    if not isinstance(value, list) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in value):
+        return None
+    return [float(x) for x in value]
+
+
+def finite_points(values: list[float]) -> tuple[list[int], list[float]]:
+    """(index, value) of the finite numbers of ``values`` (a LaserScan's ``inf``: no return)."""
+    kept = [(index, value) for index, value in enumerate(values) if math.isfinite(value)]
+    return [index for index, _ in kept], [value for _, value in kept]
+
+
+def scan_points(scan: dict[str, Any]) -> tuple[list[float], list[float]]:
+    """A decoded sensor_msgs/LaserScan's returns between its ``range_min`` and ``range_max`` as x
+    (forward) and y (left) in metres, in the scan's frame."""
+    xs: list[float] = []
+    ys: list[float] = []
+    for index, distance in enumerate(scan["ranges"]):
+        if scan["range_min"] <= distance <= scan["range_max"]:  # never a NaN
+            angle = scan["angle_min"] + index * scan["angle_increment"]
+            xs.append(distance * math.cos(angle))
+            ys.append(distance * math.sin(angle))
+    return xs, ys
+
+
+def square_limits(reach: float, columns: int, rows: int) -> tuple[float, float]:
+    """The half widths (x, y) of a plot ``columns`` x ``rows`` cells that shows ``reach`` metres around
+    the origin with a metre as long across as up (braille: 2 dots a cell across, 4 up)."""
+    across, up = 2 * max(1, columns), 4 * max(1, rows)
+    return (reach * across / up, reach) if across >= up else (reach, reach * up / across)

@@ -1,6 +1,7 @@
 """A topic: its endpoints with their QoS (the one under the cursor's in full, as ros2 topic info -v) and
 the problems between them, its rate and bandwidth (as ``roc topic hz`` and ``bw`` measure them), and a
-live echo of its latest message: ``p`` pauses it, ``f`` shows one field, ``i`` draws an image topic."""
+live echo of its latest message: ``p`` pauses it, ``f`` shows one field, ``i`` draws an image, a
+LaserScan or an OccupancyGrid."""
 
 from __future__ import annotations
 
@@ -55,7 +56,7 @@ class TopicScreen(Screen):
         Binding("f", "field", "field"),
         Binding("g", "plot", "plot a numeric field"),
         Binding("u", "publish", "publish on the topic"),
-        Binding("i", "image", "the image (sensor_msgs Image, CompressedImage) drawn"),
+        Binding("i", "image", "the image, LaserScan or OccupancyGrid drawn"),
     ]
     DEFAULT_CSS = """
     TopicScreen #title { height: 1; background: $primary; }
@@ -211,9 +212,13 @@ class TopicScreen(Screen):
         host(self).open("publish", self.topic)
 
     def action_image(self) -> None:
-        from roc.tui.images import TYPES
+        from roc.tui.image_screen import SCAN
+        from roc.tui.images import GRID, TYPES
 
         if self.type_name in TYPES:
             host(self).open("image", self.topic)
+        elif self.type_name in (SCAN, GRID):
+            host(self).open("scan" if self.type_name == SCAN else "grid", self.topic)
         else:
-            self.notify(f"{self.topic} is no image topic ({self.type_name or 'type unknown'})", severity="warning")
+            self.notify(f"{self.topic} is no image, scan or grid topic ({self.type_name or 'type unknown'})",
+                        severity="warning")

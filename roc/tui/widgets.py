@@ -15,7 +15,7 @@ from textual.widgets import DataTable, Input, Static
 from textual.widgets.data_table import ColumnKey
 
 from roc.tui.feed import Feed
-from roc.tui.model import Row, cut_widths, matches, shorten
+from roc.tui.model import Row, cell_number, cut_widths, matches, shorten, sorted_rows
 from roc.tui.problems import NO_PUBLISHER
 
 
@@ -116,6 +116,8 @@ class ListTable(DataTable):
         self.filter = ""
         self.rows_by_key: dict[str, Row] = {}
         self._all: list[Row] = []
+        self.sort_column: int | None = None  # the column the rows are sorted by (None: as given)
+        self.descending = False
         self._showing = False
         self._shown: list[str] = []
 
@@ -183,6 +185,8 @@ class ListTable(DataTable):
 
     def _show(self) -> None:
         shown = [r for r in self._all if not self.filter or matches(self.filter, *r.cells)]
+        if self.sort_column is not None:
+            shown = sorted_rows(shown, self.sort_column, self.descending)
         if not self._shown and len(shown) > self.app.size.height:
             # the first fill: the rows a screen can show now (a first paint of 200 topics costs their
             # measuring), the others right after it is painted
@@ -216,6 +220,43 @@ class ListTable(DataTable):
             self.move_cursor(row=keys.index(current), animate=False)
         self._shown = keys
         self.rows_by_key = {r.key: r for r in shown}
+
+    def sort_by(self, column: int, descending: bool | None = None) -> None:
+        """Rows sorted by ``column``: numbers largest first (as top), texts from A, unless ``descending`` says;
+        its header marked ▼ or ▲."""
+        if descending is None:
+            descending = any(cell_number(row.cells[column]) is not None for row in self._all)
+        for index, name in enumerate(self.columns_names):
+            mark = (" ▼" if descending else " ▲") if index == column else ""
+            self.columns[ColumnKey(name)].label = Text(name + mark)
+        self.sort_column, self.descending = column, descending
+        self._shown = []  # every row drawn again, in the new order
+        self.clear()
+        self.show(self._all)
+
+    def sort_next(self) -> None:
+        """Sorted by the next column (after the last: as given)."""
+        column = 0 if self.sort_column is None else self.sort_column + 1
+        if column < len(self.columns_names):
+            self.sort_by(column)
+        else:
+            for name in self.columns_names:
+                self.columns[ColumnKey(name)].label = Text(name)
+            self.sort_column = None
+            self._shown = []
+            self.clear()
+            self.show(self._all)
+
+    def sort_reversed(self) -> None:
+        if self.sort_column is not None:
+            self.sort_by(self.sort_column, not self.descending)
+
+    def on_data_table_header_selected(self, event: DataTable.HeaderSelected) -> None:
+        """A click on a column's header sorts by it (again: the other way)."""
+        column = self.columns_names.index(str(event.column_key.value)) if event.column_key.value in self.columns_names \
+            else None
+        if column is not None:
+            self.sort_by(column, not self.descending if column == self.sort_column else None)
 
     def set_filter(self, text: str) -> None:
         self.filter = text
