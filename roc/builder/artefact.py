@@ -83,8 +83,7 @@ def installed_files(name: str, places: Places, merged: bool) -> list[Path]:
     share = base / "share" / name
     found.update(p for p in share.rglob("*") if not p.is_dir() or p.is_symlink())
     found.add(base / "share" / "colcon-core" / "packages" / name)
-    return sorted(p for p in found if (p.exists() or p.is_symlink()) and base in p.parents
-                  and p.suffix != ".pyc")
+    return sorted(p for p in found if (p.exists() or p.is_symlink()) and base in p.parents)
 
 
 def not_packable(name: str, places: Places, merged: bool) -> str | None:
@@ -156,9 +155,10 @@ def _relocate(tree: Path, built_at: Places, places: Places) -> str | None:
         return None
     everything = _pattern(list(replacements))
     installed = _pattern([str(built_at.install_base).encode()])
+    byte_code = []
     for path in sorted(p for p in tree.rglob("*") if p.is_file() and not p.is_symlink()):
         if path.suffix == ".pyc":
-            path.unlink()  # byte-code caches name their sources; Python writes them again
+            byte_code.append(path)  # compiled again below, once its source is rewritten
             continue
         data = path.read_bytes()
         if _keeps_path(path, data, everything, installed):
@@ -166,7 +166,38 @@ def _relocate(tree: Path, built_at: Places, places: Places) -> str | None:
         if not _regenerated(path) and _is_text(data) and everything.search(data):
             # One pass, longest old path first: a new path containing an old one is not rewritten again.
             path.write_bytes(everything.sub(lambda match: replacements[match.group(0)], data))
+    for path in byte_code:
+        _compile_again(path, tree, places)
     return None
+
+
+def _compile_again(cached: Path, tree: Path, places: Places) -> None:
+    """Write a byte-code cache of ``tree`` again for the place its source moves to (it names the path it
+    was compiled at), as the build left it (optimisation level, invalidation mode): the install is what
+    a local build leaves. A cache this Python cannot write (another version's, no source) is dropped."""
+    import importlib.util
+    import py_compile
+    import sys
+
+    parts = cached.name.split(".")  # module.cpython-311.pyc, module.cpython-311.opt-1.pyc
+    try:
+        source = Path(importlib.util.source_from_cache(str(cached)))
+        flags = int.from_bytes(cached.read_bytes()[4:8], "little")
+    except (ValueError, NotImplementedError, OSError):
+        source, flags = None, 0
+    if source is None or not source.is_file() or parts[1] != sys.implementation.cache_tag:
+        cached.unlink()
+        return
+    optimize = int(parts[2].removeprefix("opt-") or 0) if len(parts) == 4 else 0
+    mode = (py_compile.PycInvalidationMode.TIMESTAMP if not flags & 1 else
+            py_compile.PycInvalidationMode.CHECKED_HASH if flags & 2 else py_compile.PycInvalidationMode.UNCHECKED_HASH)
+    unpacked = tree / "install"
+    shown = places.install_base / source.relative_to(unpacked) if unpacked in source.parents else source
+    try:
+        py_compile.compile(str(source), cfile=str(cached), dfile=str(shown), doraise=True, optimize=optimize,
+                           invalidation_mode=mode, quiet=2)
+    except py_compile.PyCompileError:
+        cached.unlink()
 
 
 def _members_outside(tar: tarfile.TarFile, name: str, merged: bool) -> str | None:

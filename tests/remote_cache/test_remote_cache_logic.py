@@ -262,3 +262,34 @@ def test_bad_settings_are_usage_errors_before_anything_is_written(tmp_path, argu
     assert result.returncode == 2 and result.stderr.startswith("roc: error: ") and message in result.stderr
     assert "secret" not in result.stderr and "Traceback" not in result.stderr
     assert not (tmp_path / "build").exists() and not (tmp_path / "install").exists()
+
+
+def test_byte_code_is_compiled_again_for_the_place_it_is_restored_at(tmp_path) -> None:
+    """A package restored at another path keeps the byte-code caches a local build leaves, each naming
+    its source where it is now (as the build's optimisation level and invalidation mode made it)."""
+    import importlib.util
+    import marshal
+    import py_compile
+    import sys
+
+    from roc.builder.artefact import pack
+
+    built, here = (Places(tmp_path / ws, tmp_path / ws / "build", tmp_path / ws / "install") for ws in ("a", "b"))
+    module = built.install_base / "pkg" / "lib" / "site-packages" / "mod.py"
+    module.parent.mkdir(parents=True)
+    module.write_text("WHERE = __file__\n")
+    flags = {py_compile.PycInvalidationMode.TIMESTAMP: 0, py_compile.PycInvalidationMode.CHECKED_HASH: 3}  # PEP 552
+    caches = {py_compile.compile(str(module), optimize=level, invalidation_mode=mode, doraise=True): flags[mode]
+              for level, mode in enumerate(flags)}
+    (built.install_base / "pkg" / "lib" / "site-packages" / "__pycache__" / "other.cpython-20.pyc").write_bytes(b"x")
+    archive = tmp_path / "pkg.tar.gz"
+    pack(archive, "pkg", built, merged=False)
+    package = Package(name="pkg", path=Path("src/pkg"), type="cmake")
+    assert unpack(archive, package, built, here, merged=False) is None
+    restored = here.install_base / "pkg" / "lib" / "site-packages"
+    assert sorted(p.name for p in (restored / "__pycache__").iterdir()) == sorted(Path(c).name for c in caches)
+    for cache, flag in caches.items():
+        data = (restored / "__pycache__" / Path(cache).name).read_bytes()
+        assert data[:4] == importlib.util.MAGIC_NUMBER and int.from_bytes(data[4:8], "little") == flag
+        assert marshal.loads(data[16:]).co_filename == str(restored / "mod.py")
+    assert sys.implementation.cache_tag in Path(next(iter(caches))).name
