@@ -169,6 +169,28 @@ def anything_to_build(workspace: Workspace, options: BuildOptions) -> bool:
     return any(stale_reasons(p, fingerprints.compute(p), options) for p in workspace.selected_in_order())
 
 
+def anything_the_cache_lacks(workspace: Workspace, options: BuildOptions, remote) -> bool:
+    """Whether a build would build a selected package rather than restore it from the ``remote`` cache
+    (asked in build order, up to the first miss; a cache that is down lacks everything)."""
+    from roc.remote_cache.keys import RemoteKeys
+    from roc.remote_cache.store import StoreUnavailable
+
+    if forced_reasons(options):
+        return bool(workspace.selected)
+    fingerprints = Fingerprints(workspace, options)
+    remote_keys = RemoteKeys(fingerprints.environment, fingerprints.prefixes, options.build_base)
+    for package in workspace.selected_in_order():
+        state = fingerprints.compute(package)
+        key = remote_keys.key(package.name, state.parts)  # for every package: its dependents' keys need it
+        if stale_reasons(package, state, options):
+            try:
+                if not (key and remote.holds(key)):
+                    return True
+            except StoreUnavailable:
+                return True
+    return False
+
+
 def fingerprint_packages(workspace: Workspace, options: BuildOptions) -> dict[str, PackageState]:
     """The state of every selected package now, by name."""
     fingerprints = Fingerprints(workspace, options)

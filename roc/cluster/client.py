@@ -17,6 +17,7 @@ from pathlib import Path
 
 from roc.cluster.spec import PackageWork, WorkResult
 from roc.cluster.toolchain import BUILD_RESOURCE, RESOURCE_PREFIX, resource_name
+from roc.engine.events import TaskWarning
 from roc.engine.process import TaskCancelled, TaskContext, TaskError
 from roc.errors import RocError
 
@@ -79,9 +80,22 @@ class Cluster:
         _quiet_dask_logging()
         self._capacity, self._asked = 0, 0.0
         self.lost = False
+        self._names: dict[str, str] = {}  # worker address -> name, as last asked
+        self._lost_workers: dict[str, str] = {}  # task key -> the name of the worker lost while running it
+        self.client.subscribe_topic("all", self._on_scheduler_event)
+
+    def _on_scheduler_event(self, event: tuple[float, object]) -> None:
+        """The scheduler's events (in Dask's event loop): a worker removed while it ran tasks, which Dask
+        gives to other workers; ``run`` says so for each of this client's tasks."""
+        message = event[1]
+        if isinstance(message, dict) and message.get("action") == "remove-worker":
+            address = str(message.get("worker", ""))
+            for key in message.get("processing-tasks", ()):
+                self._lost_workers[str(key)] = self._names.get(address, address)
 
     def close(self) -> None:
         try:
+            self.client.unsubscribe_topic("all")  # else the scheduler logs that it could not send this client's end
             self.client.close(timeout=5)
         except Exception:  # noqa: BLE001 - the scheduler may be gone already; nothing to keep
             pass
@@ -89,10 +103,12 @@ class Cluster:
     def workers(self) -> dict[str, dict]:
         """The scheduler's workers (address -> its information)."""
         try:
-            return dict(self.client.scheduler_info()["workers"])
+            workers = dict(self.client.scheduler_info()["workers"])
         except (OSError, TimeoutError) as error:
             self.lost = True
             raise RocError(f"lost the Dask scheduler at {self.address}: {error}") from None
+        self._names.update({address: str(info.get("name", address)) for address, info in workers.items()})
+        return workers
 
     def fitting(self) -> dict[str, float]:
         """The workers with this client's toolchain: name -> the packages it builds at once."""
@@ -134,7 +150,11 @@ class Cluster:
         fitting workers build at once, so that each has its next package waiting while a result travels,
         and at least ``local`` (--parallel-workers; 0: no limit). The rest stays in roc's ready queue,
         and what waits on a worker waits in roc's order (each task's priority is the engine's)."""
-        return local if not local else lambda: max(local, 2 * self.capacity())
+        return local if not local else lambda: self.limit(local)
+
+    def limit(self, local: int) -> int:
+        """``task_limit``'s value now."""
+        return max(local, 2 * self.capacity())
 
     def run(self, function: Callable[[PackageWork], WorkResult], work: PackageWork, key: str,
             context: TaskContext) -> WorkResult:
@@ -147,6 +167,10 @@ class Cluster:
         future = self.client.submit(function, work, key=key, resources=resources, pure=False,
                                     priority=context.priority)
         while True:
+            lost_on = self._lost_workers.pop(key, None)
+            if lost_on is not None:
+                context.emit(TaskWarning(context.name, context.kind, message=f"worker {lost_on} was lost while it ran "
+                                         f"this {context.kind}; the cluster runs it again"))
             try:
                 result = future.result(timeout=POLL_SECONDS)
             except FutureTimeout:
@@ -168,6 +192,47 @@ class Cluster:
                 raise TaskError(f"the cluster's task returned {type(result).__name__}, not a roc result: "
                                 "do the workers run this version of roc?")
             return result
+
+
+class OnDemand:
+    """A run's Cluster, connected when first needed (``get``): a build whose packages the remote cache has
+    restores them without the scheduler. A connection that failed fails each task that needs it, with
+    its reason."""
+
+    def __init__(self, connect: Callable[[], Cluster]):
+        import threading
+
+        self._connect, self._lock = connect, threading.Lock()
+        self._cluster: Cluster | None = None
+        self._failed: str | None = None
+
+    def connect(self) -> Cluster:
+        """The Cluster, connected now if it is not yet (connect's RocError when it cannot be)."""
+        with self._lock:
+            if self._cluster is None:
+                if self._failed is not None:
+                    raise RocError(self._failed)
+                try:
+                    self._cluster = self._connect()
+                except RocError as error:
+                    self._failed = str(error)
+                    raise
+            return self._cluster
+
+    def get(self) -> Cluster:
+        """``connect`` for a task's action: its failure is the task's."""
+        try:
+            return self.connect()
+        except RocError as error:
+            raise TaskError(str(error)) from None
+
+    def task_limit(self, local: int) -> int | Callable[[], int]:
+        """Cluster.task_limit once connected; ``local`` until then."""
+        return local if not local else lambda: self._cluster.limit(local) if self._cluster is not None else local
+
+    def close(self) -> None:
+        if self._cluster is not None:
+            self._cluster.close()
 
 
 def _dask_failure(error: Exception) -> str:

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 from roc.builder.state import read_state
 from roc.cluster import work as on_worker
-from roc.cluster.client import Cluster
+from roc.cluster.client import OnDemand
 from roc.cluster.files import pack_files
 from roc.cluster.spec import PackageWork
 from roc.engine.events import TaskWarning
@@ -27,6 +27,7 @@ from roc.engine.process import RanElsewhere, TaskContext, TaskError
 
 if TYPE_CHECKING:
     from roc.builder.plan import _PackageBuild
+    from roc.cluster.client import Cluster
     from roc.remote_cache.cache import RemoteCache
     from roc.workspace.load import Workspace
 
@@ -34,7 +35,7 @@ if TYPE_CHECKING:
 class ClusterBuilds:
     """A run's builds on the cluster: the action of each build task, and what was built here."""
 
-    def __init__(self, cluster: Cluster, workspace: Workspace, remote: RemoteCache, compiler_cache: str | None = None):
+    def __init__(self, cluster: OnDemand, workspace: Workspace, remote: RemoteCache, compiler_cache: str | None = None):
         self.cluster, self.workspace, self.remote, self.compiler_cache = cluster, workspace, remote, compiler_cache
         self.here: dict[str, str] = {}  # packages built here, and why (their dependents are built here too)
 
@@ -47,7 +48,8 @@ class ClusterBuilds:
             self._here(build, context, why)
             return None
         assert build.remote_key is not None and build.state is not None and build.remote_keys is not None
-        result = self.cluster.run(on_worker.build, self._work(build), f"roc-build-{build.remote_key}", context)
+        cluster = self.cluster.get()
+        result = cluster.run(on_worker.build, self._work(build, cluster), f"roc-build-{build.remote_key}", context)
         for event in result.events:
             context.emit(replace(event, task=context.name, kind=context.kind))
         if not result.ok:
@@ -80,7 +82,7 @@ class ClusterBuilds:
                 return f"it depends on {dependency}, built here"
         return None
 
-    def _work(self, build: _PackageBuild) -> PackageWork:
+    def _work(self, build: _PackageBuild, cluster: Cluster) -> PackageWork:
         assert build.state is not None and build.remote_keys is not None and build.remote_key is not None
         name, options, keys = build.package.name, build.options, build.remote_keys
         dependencies = []
@@ -100,8 +102,8 @@ class ClusterBuilds:
                      "force": options.force},
             cache_url=self.remote.settings.shown,
             cache_timeout=self.remote.settings.timeout,
-            toolchain=self.cluster.toolchain,
-            toolchain_parts=self.cluster.toolchain_parts,
+            toolchain=cluster.toolchain,
+            toolchain_parts=cluster.toolchain_parts,
             compiler_cache=self.compiler_cache,
             force=options.force,
         )

@@ -46,6 +46,7 @@ from roc.workspace.package import Package
 
 KEPT_EVENTS = (CommandStarted, CommandEnded, TaskOutput, TaskWarning, TestFailures)
 CANCEL_POLL_SECONDS = 0.25
+CLOSING = ("closing", "closed", "failed")  # a worker's distributed.core.Status names once it is going away
 
 
 class WorkFailed(Exception):
@@ -123,10 +124,12 @@ class _Work:
                           events=self.recorder.events, **result)
 
     def _watch_cancel(self, finished: threading.Event) -> None:
-        """Stop the work when the scheduler released its task (the client cancelled it, or is gone)."""
+        """Stop the work when the scheduler released its task (the client cancelled it, or is gone), or when
+        the worker closes (its scheduler stopped or was lost: nobody waits for the result any more)."""
         while not finished.wait(CANCEL_POLL_SECONDS):
             state = self.worker.state.tasks.get(self.key)
-            if state is None or state.state not in ("executing", "long-running"):
+            if (state is None or state.state not in ("executing", "long-running")
+                    or self.worker.status.name in CLOSING):
                 self.stop.set()
                 return
 

@@ -168,13 +168,17 @@ class RemoteCache:
         if self.unavailable:
             return f"remote cache unavailable ({self.unavailable})"
         try:
-            store = self.store()
-            if store.exists(f"ac/{key}") or store.exists(f"ac/{placed_key(key, self.places)}"):
+            if self.holds(key):
                 return f"in the remote cache (key {key[:12]}): it would be restored"
             return f"not in the remote cache (key {key[:12]})"
         except StoreUnavailable as error:
             self.unavailable = str(error)
             return f"remote cache unavailable ({error})"
+
+    def holds(self, key: str) -> bool:
+        """Whether the store has an entry a restore of the key would take (StoreUnavailable when it is down)."""
+        store = self.store()
+        return store.exists(f"ac/{key}") or store.exists(f"ac/{placed_key(key, self.places)}")
 
 
 def _read_entry(path: Path) -> dict | str:

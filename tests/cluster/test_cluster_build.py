@@ -134,8 +134,8 @@ def test_install_tree_equals_a_local_build_and_its_programs_run(built, tmp_path)
     local = _checkout(tmp_path, "local")
     here = roc("work", "build", cwd=local)
     assert here.returncode == 0, here.stdout + here.stderr
-    remote_files = {f for f in installed_files(ws / "install") if not f.endswith(".pyc")}
-    assert remote_files == {f for f in installed_files(local / "install") if not f.endswith(".pyc")}
+    remote_files = set(installed_files(ws / "install"))
+    assert remote_files == set(installed_files(local / "install"))  # byte-code caches included
     for name in sorted(remote_files):  # text files (scripts, hooks, CMake configs) the same, at each one's path
         mine, theirs = (ws / "install" / name), (local / "install" / name)
         if mine.is_file() and not mine.is_symlink() and b"\0" not in mine.read_bytes()[:8192]:
@@ -177,6 +177,8 @@ def test_a_worker_killed_while_building_is_replaced(servers, built, tmp_path):
         kill_processes(below)  # the killed worker's commands (a real crash would leave them to finish alone)
         out, err = client.communicate(timeout=600)
     assert client.returncode == 0, out + err
+    assert (f"roc: warning: dia_b: worker {victim} was lost while it ran this build; the cluster runs it "
+            "again") in err, err
     on = _finished_on(killed)
     assert {"dia_b", "dia_d"} <= set(on), out
     ran = in_sourced_shell(killed, "dia_b_app; dia_d_app")
@@ -254,11 +256,25 @@ def test_cluster_test_results_appear_in_test_result(built, servers):
     assert cached.returncode == 0 and " on worker-" not in cached.stdout, cached.stdout
 
 
+def test_a_build_the_cache_has_is_restored_without_the_scheduler(built, servers, tmp_path):
+    """The scheduler is needed only for what the remote cache lacks: with it down, another checkout
+    restores every package (Dask's 30 s connect timeout never waited for)."""
+    ws = _checkout(tmp_path, "cached")
+    address = f"tcp://127.0.0.1:{free_port()}"
+    result = roc("work", "build", "--cluster", address, "--remote-cache", servers[1], cwd=ws, env=servers[2])
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "(0 built, 4 restored from the remote cache, 0 up to date)" in result.stdout, result.stdout
+    assert "Dask" not in result.stderr, result.stderr
+    ran = in_sourced_shell(ws, RUN_ALL)
+    assert ran.returncode == 0 and all(said in ran.stdout for said in PROGRAMS_SAY), ran.stdout + ran.stderr
+
+
 def test_no_scheduler_is_one_line_and_nothing_restored(servers, tmp_path):
+    """What the cache lacks needs the scheduler: it is asked before anything is restored or built."""
     ws = _checkout(tmp_path, "lonely")
     address = f"tcp://127.0.0.1:{free_port()}"
     start = time.monotonic()
-    result = roc("work", "build", "--cluster", address, "--remote-cache", servers[1], cwd=ws,
+    result = roc("work", "build", "--cluster", address, "--remote-cache", f"{servers[1]}-empty", cwd=ws,
                  env={**servers[2], "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT": "2s"})
     assert result.returncode == 1 and time.monotonic() - start < 60
     assert result.stderr.startswith(f"roc: error: cannot reach the Dask scheduler at {address}"), result.stderr
@@ -368,3 +384,34 @@ def test_a_worker_out_of_disk_fails_the_package_with_the_reason(dav, tmp_path):
         assert not (ws / "install" / "dia_a").exists(), "nothing restored of a package that failed"
     finally:
         stop_all([worker, scheduler])
+
+
+def test_a_worker_stops_its_build_when_its_scheduler_dies(dav, tmp_path):
+    """The scheduler killed while a worker builds: the worker stops the build nobody waits for at once
+    (it went on for a whole compile, then logged Dask's traceback), and the client says what it lost."""
+    env = ros_env()
+    scheduler, address = start_scheduler(tmp_path / "scheduler", env)
+    root = tmp_path / "host" / "root"
+    root.mkdir(parents=True)
+    worker = start_worker(address, root, "orphan", env)
+    ws = tmp_path / "abandoned"
+    add_cmake_package(ws, "slow", "cmake_minimum_required(VERSION 3.8)\nproject(slow NONE)\n"
+                      "execute_process(COMMAND ${CMAKE_COMMAND} -E sleep 120)\n")
+    client = None
+    try:
+        wait_for_workers(address, {"orphan"}, env, [worker])
+        client = subprocess.Popen([str(BIN / "roc"), "work", "build", "--cluster", address, "--remote-cache",
+                                   f"{dav}-abandoned"], cwd=ws, env=env, stdout=subprocess.PIPE,
+                                  stderr=subprocess.PIPE, text=True)
+        _wait(lambda: building(worker, "/build/slow"), "the worker building slow", process=client)
+        scheduler.kill()
+        _wait(lambda: not building(worker, "/build/slow"), "the worker to stop the build", timeout=30)
+        out, err = client.communicate(timeout=120)
+        assert client.returncode == 1 and f"lost the Dask scheduler at {address}" in out, out + err
+    finally:
+        if client is not None and client.poll() is None:
+            client.kill()
+            client.communicate()
+        stop_all([worker, scheduler])
+    log = (root.parent / "orphan.log").read_text()
+    assert "Traceback" not in log, log

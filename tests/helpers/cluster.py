@@ -96,9 +96,14 @@ def wait_for_workers(address: str, names: set[str], env: dict[str, str] | None =
 
 
 def worker_process(nanny: subprocess.Popen) -> psutil.Process:
-    """The worker process a ``roc work worker`` or ``dask worker`` started (the nanny's child)."""
+    """The worker process a ``roc work worker`` or ``dask worker`` started: the nanny's child that
+    multiprocessing spawned (not its resource tracker, the other child)."""
     def child():
-        children = [c for c in psutil.Process(nanny.pid).children() if "python" in c.name()]
+        children = []
+        for process in psutil.Process(nanny.pid).children():
+            with contextlib.suppress(psutil.Error):
+                if "spawn_main" in " ".join(process.cmdline()):
+                    children.append(process)
         return children[0] if children else None
 
     return _wait(child, "the worker process below the nanny")

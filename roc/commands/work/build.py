@@ -329,18 +329,23 @@ def _locked_build(args, workspace, options, switches: dict[str, bool], remote, e
 
 def _connect_cluster(args, workspace, options, remote):
     """The run's ClusterBuilds with --cluster, when anything is to be built (a no-op build never loads
-    Dask): the scheduler unreachable or no worker fitting is a one-line error before anything is done."""
+    Dask). When the remote cache lacks a package, the scheduler unreachable or no worker fitting is a
+    one-line error before anything is done; when it has them all, they are restored without the
+    scheduler (connected only if a restore misses after all)."""
     if not args.cluster_address:
         return None
-    from roc.builder.uptodate import anything_to_build
+    from roc.builder.uptodate import anything_the_cache_lacks, anything_to_build
 
     if not anything_to_build(workspace, options):
         return None
-    from roc.cluster.client import connect
+    from roc.cluster.client import OnDemand, connect
     from roc.cluster.remote_build import ClusterBuilds
 
+    cluster = OnDemand(partial(connect, args.cluster_address, options.install_base))
+    if anything_the_cache_lacks(workspace, options, remote):
+        cluster.connect()
     compiler = None if args.compiler_cache == "none" else args.compiler_cache
-    return ClusterBuilds(connect(args.cluster_address, options.install_base), workspace, remote, compiler)
+    return ClusterBuilds(cluster, workspace, remote, compiler)
 
 
 def _build(args, workspace, options, switches: dict[str, bool], remote, compiler,
