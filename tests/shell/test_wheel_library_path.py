@@ -73,3 +73,21 @@ def test_sourcing_a_workspace_built_on_the_wheels_gives_its_programs_their_libra
     site = venv / "lib" / "python3.11" / "site-packages"
     assert result.stdout.split(":") == [str(home / "lib"), str(site / "ros_rcl.libs"), str(site / "ros_fastrtps.libs"),
                                         str(venv / "lib")]
+
+
+def test_a_wheel_venv_entry_already_listed_keeps_its_place_as_colcon_leaves_it(tmp_path: Path, monkeypatch) -> None:
+    """A workspace W sourced first, then the setup script of another install U built on the same wheels:
+    W's libraries stay before the venv's (colcon's scripts never touch the venv's entries)."""
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    venv = wheel_venv(tmp_path, pyenv_python(tmp_path))
+    base = tmp_path / "u" / "install"
+    base.mkdir(parents=True)
+    write_install_scripts(base, [], merged=False,
+                          underlays=chained_underlays({"AMENT_PREFIX_PATH": str(venv)}, base))
+    sourced_first = f"/w/install/w_pkg/lib:{venv}/lib"
+    result = subprocess.run(["bash", "-c", f'source "$1" && printf %s "${LIBRARIES}"', "_", str(base / "setup.bash")],
+                            capture_output=True, text=True, check=True,
+                            env={"PATH": "/usr/bin:/bin", LIBRARIES: sourced_first})
+    entries = result.stdout.split(":")
+    assert entries.index("/w/install/w_pkg/lib") < entries.index(f"{venv}/lib"), entries
+    assert entries[-2:] == ["/w/install/w_pkg/lib", f"{venv}/lib"]
