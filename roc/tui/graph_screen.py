@@ -84,7 +84,7 @@ class GraphScreen(Screen):
     GraphScreen #tabs { height: 1fr; }
     GraphScreen #system { layout: horizontal; height: 1fr; }
     GraphScreen #system.narrow { layout: vertical; }
-    GraphScreen #system #nodes-table { width: 1fr; min-width: 44; max-width: 72; }
+    GraphScreen #system #nodes-table { width: 1fr; min-width: 46; max-width: 72; }
     GraphScreen #system #topics-table { width: 2fr; }
     GraphScreen #system.narrow #nodes-table { width: 1fr; max-width: 100%; height: 2fr; }
     GraphScreen #system.narrow #topics-table { width: 1fr; height: 3fr; }
