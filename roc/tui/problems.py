@@ -70,7 +70,7 @@ class Watch:
                  diagnostic_errors: Sequence[tuple[str, str]] = ()) -> list[Problem]:
         """``topics``, ``nodes``: what is shown; ``rate(topic)``: its measured rate or None;
         ``diagnostic_errors``: (key, text) of each /diagnostics status in ERROR."""
-        found = [Problem("diagnostic", key, text) for key, text in diagnostic_errors]
+        found = []
         for topic in topics:
             for text in topic_diagnoses(topic):
                 found.append(Problem("topic", topic["name"], f"{topic['name']}: {text}",
@@ -79,7 +79,7 @@ class Watch:
             found.append(Problem("node", node, f"{node}: gone since {time.strftime('%H:%M:%S', time.localtime(when))}"))
         if self.checks is not None:
             found += self._unmet(topics, nodes, rate)
-        return found
+        return found + [Problem("diagnostic", key, text) for key, text in diagnostic_errors]
 
     def _unmet(self, topics: list[dict[str, Any]], nodes: list[str], rate) -> list[Problem]:
         assert self.checks is not None
