@@ -130,12 +130,17 @@ def refuse_mix(environ: Mapping[str, str] | None = None) -> None:
 
 
 class _RclpyImportGuard:
-    """A finder first on ``sys.meta_path`` that lets rclpy be imported only once ``refuse_mix`` passed: it
-    sees every import of rclpy, whichever module asks (the graph, bags, the bridge, the TUI, launch)."""
+    """A finder first on ``sys.meta_path`` that lets rclpy be imported only once ``refuse_mix`` passed, and
+    after the middleware RMW_IMPLEMENTATION names is loaded where librcl would load another
+    (roc.middleware.load_chosen): it sees every import of rclpy, whichever module asks (the graph, bags, the
+    bridge, the TUI, launch)."""
 
     def find_spec(self, name: str, path: Sequence[str] | None = None, target: object = None) -> None:
         if name == "rclpy":
+            from roc.middleware import load_chosen
+
             refuse_mix()  # raises before any of rclpy's libraries is loaded
+            load_chosen()
             sys.meta_path.remove(self)
         return None  # the ordinary finders find it
 

@@ -28,6 +28,7 @@ def run(args: argparse.Namespace) -> int:
     import sys
 
     from roc.ament_index import find_executable
+    from roc.middleware import process_environment
 
     path = str(find_executable(args.package_name, args.executable_name))
     try:
@@ -35,10 +36,11 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as error:
         raise RocError(f"--prefix {args.prefix!r}: {error}") from None
     command = [*prefix, path, *args.argv]
+    env = process_environment(os.environ)  # the middleware RMW_IMPLEMENTATION names, on the ROS 2 wheels
     sys.stdout.flush()
     sys.stderr.flush()
     try:
-        os.execvp(command[0], command)
+        os.execvpe(command[0], command, env)
     except OSError as error:
         raise RocError(f"cannot run '{command[0]}': {error.strerror}") from None
     return 1  # not reached: exec replaced this process

@@ -1,6 +1,6 @@
 """The checks of ``roc doctor`` for defects of ROS 2's PyPI wheels that no file edit repairs (the CMake
 files' are ``wheel_repairs``): packages an ament_cmake build needs that the meta wheels do not pull in,
-and librcl linking one middleware directly, so that RMW_IMPLEMENTATION cannot choose another."""
+and librcl linking one middleware directly, so that RMW_IMPLEMENTATION alone cannot choose another."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from roc import distribution as ros_distribution
+from roc import middleware
 from roc.doctor.findings import Finding
 from roc.environment import ament_prefixes
 
@@ -20,9 +21,6 @@ AMENT_INDEX = Path("share") / "ament_index" / "resource_index" / "packages"
 FORGOTTEN = ("ament_package", "ament_cmake_include_directories", "rosidl_core_generators", "python_cmake_module",
              "ament_cmake_gmock", "ament_cmake_gtest", "ament_cmake_pytest")
 _EXPORTED_TOOL = re.compile(r"<buildtool_export_depend[^>]*>\s*([\w-]+)\s*</buildtool_export_depend>")
-# a middleware's library named in librcl's dynamic section: librcl then loads it, not RMW_IMPLEMENTATION's
-_RMW_LIBRARY = re.compile(rb"\0lib(rmw_(?!implementation\b|dds_common\b)[a-z0-9_]+?)\.so\0")
-_NOT_MIDDLEWARES = ("_shared_cpp", "_shared_c")
 
 
 def wheel_prefixes() -> list[Path]:
@@ -68,35 +66,28 @@ def missing_packages(env: Mapping[str, str], prefixes: list[Path] | None = None)
                    details={"missing": names})
 
 
-def linked_middleware(librcl: Path) -> str | None:
-    """The middleware librcl links directly (the ROS 2 wheels' librcl links rmw_fastrtps_cpp), None when it
-    loads the one RMW_IMPLEMENTATION names (through rmw_implementation), as a source or apt build does."""
-    try:
-        data = librcl.read_bytes()
-    except OSError:
-        return None
-    for match in _RMW_LIBRARY.finditer(data):
-        name = match.group(1).decode()
-        if not name.endswith(_NOT_MIDDLEWARES):
-            return name
-    return None
-
-
 def linked_rmw(env: Mapping[str, str], prefixes: list[Path] | None = None) -> Finding:
-    """RMW_IMPLEMENTATION naming another middleware than the one librcl links: it cannot take effect."""
+    """The middleware librcl links directly (the ROS 2 wheels'), and whether roc can still give its processes
+    the one RMW_IMPLEMENTATION names (roc.middleware: loaded first, LD_PRELOAD for the nodes it starts)."""
     for prefix in ament_prefixes() if prefixes is None else prefixes:
         librcl = prefix / "lib" / "librcl.so"
         if not librcl.is_file():
             continue
-        linked = linked_middleware(librcl)
+        linked = middleware.linked_middleware(librcl)
         if linked is None:
             return Finding(CATEGORY, "linked rmw", "ok", "librcl loads the middleware RMW_IMPLEMENTATION names")
         chosen = env.get("RMW_IMPLEMENTATION")
+        details = {"librcl": str(librcl), "linked": linked}
         if chosen and chosen != linked:
-            return Finding(CATEGORY, "linked rmw", "error", f"{librcl} links {linked} directly (the ROS 2 wheels "
-                           f"do): RMW_IMPLEMENTATION={chosen} cannot take effect",
-                           f"unset RMW_IMPLEMENTATION (these wheels run {linked} only; another middleware needs "
-                           "a ROS 2 install from apt or source)", details={"librcl": str(librcl), "linked": linked})
-        return Finding(CATEGORY, "linked rmw", "ok", f"{linked}, which librcl links directly (ROS 2 wheels): "
-                       "RMW_IMPLEMENTATION can name no other")
+            library = middleware.installed(env).get(chosen)
+            if library is None or not library.is_file():
+                return Finding(CATEGORY, "linked rmw", "error", f"{librcl} links {linked} directly (the ROS 2 "
+                               f"wheels do) and RMW_IMPLEMENTATION={chosen} is not installed",
+                               f"source the setup script of the workspace that built {chosen} (see roc's "
+                               f"middlewares page), or unset RMW_IMPLEMENTATION to use {linked}", details=details)
+            return Finding(CATEGORY, "linked rmw", "info", f"{librcl} links {linked} directly (the ROS 2 wheels "
+                           f"do): roc loads {chosen} first for itself and the nodes roc run and roc launch start; "
+                           f"other programs need LD_PRELOAD={library}", details={**details, "library": str(library)})
+        return Finding(CATEGORY, "linked rmw", "ok", f"{linked}, which librcl links directly (ROS 2 wheels); "
+                       "roc gives its processes another one that RMW_IMPLEMENTATION names and the ament index has")
     return Finding(CATEGORY, "linked rmw", "ok", "no librcl found")

@@ -18,6 +18,7 @@ from roc.launch.check import CheckOptions
 from roc.launch.guard import Guard
 from roc.launch.monitor import Monitor
 from roc.launch.view import LiveView, PlainOutput
+from roc.middleware import process_environment
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
@@ -61,8 +62,9 @@ class Running:
         self._previous: dict[int, object] = {}
 
     def environment(self, extra: dict[str, str] | None = None) -> dict[str, str]:
-        """The environment of every process the run starts: roc's, with the guard's token."""
-        return self.guard.environment({**os.environ, **(extra or {})})
+        """The environment of every process the run starts: roc's, with the guard's token and the middleware
+        RMW_IMPLEMENTATION names (roc.middleware)."""
+        return self.guard.environment(process_environment({**os.environ, **(extra or {})}))
 
     def catch_signals(self, stop: Callable[[], None]) -> None:
         """SIGINT, SIGTERM and SIGHUP (a closed terminal) call ``stop`` once; a second one stops every

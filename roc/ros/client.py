@@ -166,6 +166,7 @@ def spawn_daemon() -> None:
     time, and echo lost 10-35 k of 50 k messages at 5 kHz where it now loses 0-2.5 k
     (bench/dataplane_bench.py)."""
     from roc.distribution import refuse_mix
+    from roc.middleware import process_environment
 
     refuse_mix()  # the daemon, started with this environment, would load two distributions' libraries
     path = socket_path()
@@ -182,6 +183,7 @@ def spawn_daemon() -> None:
             with open(path.with_suffix(".log"), "ab") as log:
                 # not one of a roc launch's processes, even when one of them starts it (roc/launch/guard.py's token)
                 env = {name: value for name, value in os.environ.items() if name != "ROC_LAUNCH_ID"}
+                env = process_environment(env)  # the middleware RMW_IMPLEMENTATION names (roc/middleware.py)
                 subprocess.Popen([sys.executable, "-m", "roc.ros.daemon", str(path), str(listener.fileno())],
                                  stdin=subprocess.DEVNULL, stdout=log, stderr=log, process_group=0,
                                  pass_fds=(listener.fileno(),), env=env)

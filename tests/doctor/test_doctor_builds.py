@@ -8,6 +8,7 @@ import os
 import sys
 from pathlib import Path
 
+from roc import middleware
 from roc.doctor import build_tools, wheel_defects
 
 
@@ -108,16 +109,30 @@ def _librcl(tmp_path: Path, needed: list[str]) -> Path:
     return tmp_path
 
 
-def test_rmw_implementation_naming_another_middleware_than_librcl_links_is_an_error(tmp_path: Path) -> None:
+def test_rmw_implementation_naming_another_middleware_than_librcl_links_and_not_installed_is_an_error(
+        tmp_path: Path) -> None:
     prefix = _librcl(tmp_path, ["librmw_fastrtps_cpp.so", "librmw.so", "librmw_fastrtps_shared_cpp.so",
                                 "librmw_dds_common.so"])
     finding = wheel_defects.linked_rmw({"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"}, [prefix])
     assert finding.level == "error"
-    assert finding.message == (f"{prefix}/lib/librcl.so links rmw_fastrtps_cpp directly (the ROS 2 wheels do): "
-                               "RMW_IMPLEMENTATION=rmw_cyclonedds_cpp cannot take effect")
-    assert finding.fix.startswith("unset RMW_IMPLEMENTATION")
+    assert finding.message == (f"{prefix}/lib/librcl.so links rmw_fastrtps_cpp directly (the ROS 2 wheels do) and "
+                               "RMW_IMPLEMENTATION=rmw_cyclonedds_cpp is not installed")
+    assert finding.fix.endswith("or unset RMW_IMPLEMENTATION to use rmw_fastrtps_cpp")
     assert wheel_defects.linked_rmw({"RMW_IMPLEMENTATION": "rmw_fastrtps_cpp"}, [prefix]).level == "ok"
     assert wheel_defects.linked_rmw({}, [prefix]).level == "ok"
+
+
+def test_another_installed_middleware_than_librcl_links_is_loaded_by_roc_and_preloaded_by_others(
+        tmp_path: Path) -> None:
+    prefix = _librcl(tmp_path, ["librmw_fastrtps_cpp.so", "librmw.so"])
+    (prefix / "share/ament_index/resource_index/rmw_typesupport").mkdir(parents=True)
+    (prefix / "share/ament_index/resource_index/rmw_typesupport/rmw_cyclonedds_cpp").write_text("")
+    (prefix / "lib" / "librmw_cyclonedds_cpp.so").write_bytes(b"")
+    finding = wheel_defects.linked_rmw({"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp", "AMENT_PREFIX_PATH": str(prefix)},
+                                       [prefix])
+    assert finding.level == "info"
+    assert finding.message.endswith("roc loads rmw_cyclonedds_cpp first for itself and the nodes roc run and roc "
+                                    f"launch start; other programs need LD_PRELOAD={prefix}/lib/librmw_cyclonedds_cpp.so")
 
 
 def test_a_librcl_that_loads_the_middleware_at_run_time_lets_rmw_implementation_choose(tmp_path: Path) -> None:
@@ -127,4 +142,4 @@ def test_a_librcl_that_loads_the_middleware_at_run_time_lets_rmw_implementation_
 
 
 def test_the_wheels_librcl_links_fast_dds() -> None:
-    assert wheel_defects.linked_middleware(Path(sys.prefix) / "lib" / "librcl.so") == "rmw_fastrtps_cpp"
+    assert middleware.linked_middleware(Path(sys.prefix) / "lib" / "librcl.so") == "rmw_fastrtps_cpp"

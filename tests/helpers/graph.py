@@ -16,6 +16,7 @@ from helpers.build import BIN, DISTRO, REQUIREMENTS, ros_domain_id, stop_process
 from helpers.build import roc as roc_build
 from helpers.oracles import SHARED, require_oracle
 from helpers.rmw import middleware_prefixes
+from roc.middleware import process_environment
 
 NODE_SCRIPT = Path(__file__).resolve().parents[1] / "nodes" / "graph_node.py"
 # the real ros2 CLI, in a venv of the tests' distribution's wheels (Jazzy's keeps its first name)
@@ -52,8 +53,10 @@ def graph_env(slot: int, runtime_dir: Path, **extra: str) -> dict[str, str]:
 
 
 def start_nodes(specs: list, env: dict[str, str]) -> list[subprocess.Popen]:
-    """One process per entry of ``specs``; returns once each printed "ready"."""
+    """One process per entry of ``specs``, on the middleware ``env`` names (as roc run starts a node:
+    roc.middleware); returns once each printed "ready"."""
     processes = []
+    env = process_environment(env)
     for spec in specs:
         process = subprocess.Popen([sys.executable, str(NODE_SCRIPT), json.dumps(spec)], env=env,
                                    stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)

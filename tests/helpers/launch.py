@@ -14,6 +14,7 @@ from pathlib import Path
 
 from helpers.build import BIN, FIXTURES, stop_process
 from helpers.graph import ORACLE_VENV, graph_env, roc
+from helpers.rmw import middleware_prefixes
 
 SITE = f"lib/python{sys.version_info.major}.{sys.version_info.minor}/site-packages"
 DEMO_NODES = {"/robot1/talker", "/robot1/listener", "/map_server"}
@@ -46,7 +47,7 @@ def build_demo(directory: Path) -> Path:
 def demo_env(slot: int, runtime: Path, prefix: Path, **extra: str) -> dict[str, str]:
     """The test's ROS domain with roc_launch_demo sourced over the wheels (and the oracle's venv)."""
     env = graph_env(slot, runtime, **extra)
-    env["AMENT_PREFIX_PATH"] = os.pathsep.join([str(prefix), str(ORACLE_VENV), sys.prefix])
+    env["AMENT_PREFIX_PATH"] = os.pathsep.join([str(prefix), *middleware_prefixes(), str(ORACLE_VENV), sys.prefix])
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(prefix / SITE), env.get("PYTHONPATH")]))
     env.pop("ROC_LAUNCH_ID", None)
     return env
