@@ -141,10 +141,16 @@ def subscribe_filtered(receiver: Receiver, topic: str, cls, qos: QoSProfile, fou
     return {"by": "roc", "reason": unfiltered} if unfiltered else {"by": "middleware", "reason": None}
 
 
+def total_lost(counts: list[int | None]) -> int | None:
+    """The sum of lost-message counts; None (unknown) when one of them is unknown."""
+    return None if None in counts else sum(count for count in counts if count is not None)
+
+
 def echo(graph, params: dict[str, Any]) -> Events:
     """Subscribe to ``params["topic"]`` and yield ``{"event": "messages", "messages": [{data, info,
     lost}]}`` with what arrived since the last event (``lost``: messages the publisher's sequence
-    numbers say never arrived), ``{"event": "subscribed", "type"}`` first and heartbeats in between.
+    numbers say never arrived; None, unknown, where the middleware gives none: Cyclone DDS),
+    ``{"event": "subscribed", "type"}`` first and heartbeats in between.
     Params: ``topic``, ``wait`` (seconds to wait for a publisher to be discovered), ``type`` (else the
     graph's), ``qos`` (see qos_profile), ``timeout`` (seconds for the first message, counted from the
     start, the wait for a publisher included; then ``{"event": "timeout"}`` ends the stream),
@@ -174,13 +180,16 @@ def echo(graph, params: dict[str, Any]) -> Events:
             batch = receiver.batch(seconds, MAX_BATCH)
             return [item for item in batch if local.accepts(deserialize_message(item[1], cls))] if local else batch
 
-        def lost(info: dict[str, Any]) -> int:
-            """The messages of info's publisher that never arrived since its last one (info loses its gid)."""
+        def lost(info: dict[str, Any]) -> int | None:
+            """The messages of info's publisher that never arrived since its last one (info loses its gid);
+            None, unknown, where the middleware gives no sequence numbers (Cyclone DDS)."""
             sequence, gid = info["publication_sequence_number"], info.pop("gid")
             if wanted is not None:
                 return 0  # the messages filtered out are not lost
+            if sequence is None:
+                return None
             previous, last_sequence[gid] = last_sequence.get(gid), sequence
-            return max(sequence - previous - 1, 0) if sequence is not None and previous is not None else 0
+            return max(sequence - previous - 1, 0) if previous is not None else 0
         while True:
             batch = received(HEARTBEAT_SECONDS)
             if not batch:
@@ -190,18 +199,18 @@ def echo(graph, params: dict[str, Any]) -> Events:
                 yield {"event": "heartbeat"}
                 continue
             deadline = None  # a message arrived: the timeout is over
-            carried = 0  # lost before the messages left out for ``latest_every``
+            carried: int | None = 0  # lost before the messages left out for ``latest_every``
             if latest_every:  # until it is due, newer messages replace the ones kept
                 while (remaining := sent + latest_every - time.monotonic()) > 0:
                     if newer := received(remaining):
-                        carried += sum(lost(info) for _, _, info in batch)
+                        carried = total_lost([carried, *(lost(info) for _, _, info in batch)])
                         batch = newer
-                carried += sum(lost(info) for _, _, info in batch[:-1])
+                carried = total_lost([carried, *(lost(info) for _, _, info in batch[:-1])])
                 batch, sent = batch[-1:], time.monotonic()
             messages: list[dict[str, Any]] = [
                 {"data": base64.b64encode(data).decode(), "lost": lost(info),
                  "info": {key: value for key, value in info.items() if value is not None}} for _, data, info in batch]
-            messages[0]["lost"] += carried
+            messages[0]["lost"] = total_lost([messages[0]["lost"], carried])
             if params.get("latest_value"):
                 messages[-1]["value"] = value_to_data(deserialize_message(batch[-1][1], cls),
                                                       truncate_length=params.get("truncate_length"))

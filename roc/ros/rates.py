@@ -36,14 +36,20 @@ class Window:
     def __init__(self, size: int):
         self.samples: deque[Sample] = deque(maxlen=size)
         self.lost = 0
+        self.unsequenced = False  # a message came without a sequence number (Cyclone DDS): loss unknown
 
     def add(self, new: list[Sample]) -> None:
         for sample in new:
+            self.unsequenced |= sample.sequence is None
             last = self.samples[-1] if self.samples else None
             if (last and last.sequence is not None and sample.sequence is not None
                     and sample.sequence > last.sequence + 1):
                 self.lost += sample.sequence - last.sequence - 1
             self.samples.append(sample)
+
+    def known_lost(self) -> int | None:
+        """The messages lost among the samples, None (unknown) when some came without a sequence number."""
+        return None if self.unsequenced else self.lost
 
     def rate(self, wall_time: bool = False) -> dict | None:
         """``{rate, min, max, std_dev, window}`` (seconds between messages), or None before two samples."""

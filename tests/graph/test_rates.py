@@ -27,6 +27,16 @@ def test_rate_is_the_publishers_despite_losses_and_late_reception() -> None:
     assert window.rate(wall_time=True)["rate"] == pytest.approx(5 / 0.066)
 
 
+def test_loss_is_unknown_not_zero_without_sequence_numbers() -> None:
+    window = Window(10)  # Cyclone DDS gives no publication sequence numbers
+    window.add([Sample(None, n * 10 * MS, n * 10 * MS, 10, None) for n in range(5)])
+    assert window.rate()["rate"] == pytest.approx(100.0)
+    assert window.known_lost() is None
+    sequenced = Window(10)
+    sequenced.add([_sample(1, 0), _sample(3, 20)])
+    assert sequenced.known_lost() == 1
+
+
 def test_window_keeps_the_last_messages_and_needs_two() -> None:
     window = Window(3)
     window.add([_sample(1, 0)])

@@ -5,6 +5,7 @@ but not loadable is a one-line error naming it and the fix."""
 
 from __future__ import annotations
 
+import json
 import shutil
 import subprocess
 from pathlib import Path
@@ -100,3 +101,21 @@ def test_roc_and_the_nodes_it_runs_and_launches_are_on_cyclone_dds(tmp_path: Pat
         stop_daemon(env)
         kill_leftovers(str(launch_demo_prefix))
     assert "102" not in ran.stderr.read()
+
+
+@pytest.mark.slow
+@pytest.mark.rmw
+def test_loss_is_unknown_on_cyclone_dds_in_echo_and_hz(tmp_path: Path) -> None:
+    require_cyclonedds()
+    env = on_middleware(graph_env(SLOT, tmp_path), CYCLONEDDS)
+    nodes = start_nodes([[{"name": "talker", "publishers": [{"topic": "chatter", "type": "std_msgs/msg/String",
+                                                             "values": {"data": "hi"}, "rate_hz": 20}]}]], env)
+    try:
+        echoed = roc("topic", "echo", "/chatter", "--once", "--format", "json", "--no-daemon", env=env)
+        assert echoed.returncode == 0, echoed.stderr
+        assert json.loads(echoed.stdout)["lost"] is None
+        assert "lost messages on /chatter are unknown: the middleware gives no publication sequence numbers" in \
+            echoed.stderr
+    finally:
+        stop_all(nodes)
+        stop_daemon(env)

@@ -52,6 +52,7 @@ class TopicStats:
     received: int = 0
     written: int = 0
     lost: int = 0  # gaps in the publishers' sequence numbers
+    unsequenced: int = 0  # messages without a sequence number (Cyclone DDS gives none): their loss is unknown
     last_sequence: dict[str, int] = field(default_factory=dict)  # by publisher gid
 
 
@@ -146,6 +147,8 @@ class Recorder:
                 if previous is not None and sequence > previous + 1:
                     stats.lost += sequence - previous - 1
                 stats.last_sequence[gid] = sequence
+            else:
+                stats.unsequenced += 1
             if self.paused:
                 self._paused_dropped += 1
                 continue

@@ -123,10 +123,16 @@ def _summary(result, uri: str) -> list[str]:
     lines = [f"Recorded {plural(metadata.message_count, 'message')} on {plural(len(metadata.topics), 'topic')} "
              f"into {uri} ({plural(len(metadata.relative_file_paths), 'file')})"]
     if result.stats:
-        lines += table_lines([[name, s.received, s.written, s.lost] for name, s in result.stats.items()],
-                             header=["topic", "received", "written", "lost"])
+        lines += table_lines([[name, s.received, s.written, "unknown" if s.unsequenced else s.lost]
+                              for name, s in result.stats.items()], header=["topic", "received", "written", "lost"])
     lost = sum(s.lost for s in result.stats.values())
-    lines.append(f"Lost messages: {lost} (gaps in the publishers' sequence numbers)")
+    unknown = sum(1 for s in result.stats.values() if s.unsequenced)
+    if unknown:
+        known = f"; {lost} on the other topics" if unknown < len(result.stats) else ""
+        lines.append(f"Lost messages: unknown on {plural(unknown, 'topic')} (the middleware gives no publication "
+                     f"sequence numbers){known}")
+    else:
+        lines.append(f"Lost messages: {lost} (gaps in the publishers' sequence numbers)")
     if result.repeated:
         lines.append(f"Repeated at the start of split files: {result.repeated} (--repeat-transient-local)")
     if result.paused_dropped:

@@ -77,6 +77,7 @@ def run(args: argparse.Namespace) -> int:
               "wait": args.timeout if args.timeout is not None else publisher_wait(args),
               "timeout": args.timeout, "content_filter": content_filter_options(args)}
     lost_total = 0
+    lost_unknown = False  # said once: the middleware gives no sequence numbers (Cyclone DDS)
     type_name = args.message_type
     for event in stream("echo", params, use_daemon=not args.no_daemon):
         kind = event["event"]
@@ -90,6 +91,10 @@ def run(args: argparse.Namespace) -> int:
         elif kind == "messages":
             texts = []  # a backlog is written at once
             for message in event["messages"]:
+                if message["lost"] is None and not lost_unknown and not args.no_lost_messages:
+                    lost_unknown = True
+                    print_text(f"roc: lost messages on {args.topic_name} are unknown: the middleware gives no "
+                               "publication sequence numbers\n", sys.stderr)
                 if message["lost"] and not args.no_lost_messages:
                     lost_total += message["lost"]
                     print_text(f"A message was lost!!!\n\ttotal count change:{message['lost']}\n\ttotal count: "

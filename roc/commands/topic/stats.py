@@ -61,7 +61,7 @@ def watch(args: argparse.Namespace, measure: Measure, text: Text, *, stamps: boo
                     continue
                 results[topic] = result
                 if args.format == "json":
-                    print_json_line({"topic": topic, **result, "lost": windows[topic].lost})
+                    print_json_line({"topic": topic, **result, "lost": windows[topic].known_lost()})
                 if windows[topic].lost > reported_lost[topic]:
                     print_text(f"roc: {windows[topic].lost - reported_lost[topic]} message(s) lost on {topic} "
                                "(publisher sequence numbers)\n", sys.stderr)
