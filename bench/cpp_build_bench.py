@@ -66,8 +66,8 @@ def environment() -> dict[str, str]:
 def commands(tool: str) -> list[str]:
     if tool == "roc":
         return [str(BIN / "roc"), "work", "build", "--parallel-workers", "2", *OVERRIDE, *RELEASE]
-    return [str(BIN / "colcon"), "build", "--parallel-workers", "2", "--allow-overriding", "composition_interfaces",
-            *RELEASE]
+    # colcon without colcon-override-check (the oracle's set) overrides the venv's package without asking
+    return [str(BIN / "colcon"), "build", "--parallel-workers", "2", *RELEASE]
 
 
 def load() -> str:

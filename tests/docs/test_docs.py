@@ -190,7 +190,7 @@ def test_the_examples_print_what_the_page_shows(sequence: Sequence, tmp_path: Pa
 def test_the_manual_says_what_a_newcomer_needs_to_know() -> None:
     """(The examples of the manual and the README are run by tests/docs/test_docs.py.)"""
     work = " ".join((REPO / "docs" / "commands" / "work.md").read_text().split())
-    assert "the PyPI wheels of this repository's `.venv` have no rclcpp" in work
+    assert "on the PyPI wheels (which have none) rclcpp built from source as an underlay" in work
     assert "That file is roc's own JSON-lines event format, not colcon's" in work
     bench = (REPO / "bench" / "README.md").read_text()
     assert "/work/" not in bench and "/home/" not in bench
