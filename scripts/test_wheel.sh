@@ -180,9 +180,15 @@ smoke() {
 # ---- 3. the wheels' way: roc in the ROS venv ------------------------------------------------------
 scenario=wheels
 say "roc's wheel into the ROS venv (colcon, setuptools 68.1.2)"
+"$ROS/bin/pip" freeze --all | sort >"$WORK/ros-before.txt"
 check "pip install into the ROS venv" "$ROS/bin/pip" install -q "$WHEEL"
 check "setuptools is still 68.1.2" "$ROS/bin/python" -c \
     'import setuptools, sys; print(setuptools.__version__); sys.exit(setuptools.__version__ != "68.1.2")'
+# roc only adds: no package of ROS's or colcon's is upgraded, downgraded or removed
+nothing_changed() {  # the packages installed before, each still at its version (the lines that went are printed)
+    ! "$ROS/bin/pip" freeze --all | sort | comm -23 "$WORK/ros-before.txt" - | grep .
+}
+check "no installed package changed" nothing_changed
 check "pip check" "$ROS/bin/pip" check
 colcon_works() {
     rm -rf "$WORK/colcon" && mkdir -p "$WORK/colcon/src" && cd "$WORK/colcon" || return
