@@ -101,6 +101,9 @@ class LiveGraph:
         self.processes = start(workspace, env, root)
         try:
             wait_for(lambda: self.nodes <= set(roc("node", "list", env=env).stdout.split()), timeout=60)
+            # the first verb answered in its own process and started the daemon: the pages show a warm one
+            wait_for(lambda: '"ready": true' in roc("daemon", "status", "--format", "json", env=env).stdout,
+                     timeout=60)
         except BaseException:
             self.stop()
             raise
