@@ -1,22 +1,25 @@
 """How many participants a fresh participant must discover before its graph is complete, so that a
-first query answers as soon as it has seen everything instead of after a fixed wait.
-
-Two facts make the local part exact:
-- every RTPS participant binds the metatraffic unicast UDP port its domain and participant id give
-  (RTPS 9.6.1.1: 7400 + 250 * domain + 10 + 2 * id) and the user-data port above it, so
-  ``/proc/net/udp`` tells how many participants this host has in a domain, whether or not they have
-  been heard yet;
-- every ROS participant has one writer on ``ros_discovery_info`` (rmw_dds_common), and Fast DDS's GUID
-  prefix carries the writer's host id (bytes 2-3) and process id (bytes 4-5, little-endian), so the
-  writers seen tell which of those participants have been discovered.
+first query answers as soon as it has seen everything instead of after a fixed wait. Nothing here
+assumes a DDS vendor's GUID layout (what differs between vendors: roc.ros.vendors); it holds for every
+RTPS vendor:
+- every participant binds the metatraffic unicast UDP port its domain and participant id give
+  (RTPS 9.6.1.1: 7400 + 250 * domain + 10 + 2 * id) and the user-data port above it (Fast DDS, and
+  Cyclone DDS on the LOCALHOST and SUBNET ranges), so ``/proc/net/udp`` tells how many participants
+  this host has in a domain, whether or not they have been heard yet;
+- every participant answers a participant new to it with its own announcement at once, and an RTPS
+  message's header names its sender's GUID prefix, so the answers to a stand-in's announcement sent to
+  those ports name this host's participants (``LocalParticipantProbe``);
+- a participant's endpoints share its GUID prefix, and every ROS participant has one writer on
+  ``ros_discovery_info`` (rmw_dds_common), so the writers discovered tell which of this host's
+  participants have been discovered (``local_peers_discovered``).
 
 A participant discovered is not wholly known yet: its nodes come in its ``ros_discovery_info`` message
 (under load 0.1 s and more after its writer), and each endpoint in an announcement of its own, which
 may come later still. It is once its message has come and every node and endpoint GID the message
 lists has been discovered (``incomplete_participants``; the message is read by
-roc.ros.discovery_info).
+roc.ros.discovery_info, and names its participant's GUID).
 
-A fresh participant's first announcement goes out before Fast DDS listens, so it would hear some of
+A fresh Fast DDS participant's first announcement goes out before it listens, so it would hear some of
 them only at their next periodic announcement: it asks them to announce themselves again
 (``ask_local_participants_to_announce``, roc.ros.spdp), with input buffers large enough for all their
 answers at once (``enlarge_input_buffers``).
@@ -31,6 +34,7 @@ from __future__ import annotations
 import contextlib
 import os
 import socket
+import time
 from collections.abc import Container, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,8 +50,10 @@ USER_PORT_OFFSET = 1  # a participant's user-data unicast port, above its metatr
 UNKNOWN_NODE = "_NODE_NAME_UNKNOWN_"  # rmw_dds_common's name for the node of an endpoint not told yet
 MAX_PARTICIPANT_ID = 119  # the highest id whose ports stay within the domain's 250
 DISCOVERY_TOPIC = "ros_discovery_info"  # a DDS name, outside ROS's conventions (no rt/ prefix)
-FAST_DDS_VENDOR = b"\x01\x0f"
 UDP_TABLES = (Path("/proc/net/udp"), Path("/proc/net/udp6"))
+GUID_PREFIX_BYTES = 12
+RTPS_HEADER_BYTES = 20  # "RTPS", version, vendor id, then the sender's GUID prefix (RTPS 8.3.3.1)
+ASK_AGAIN_SECONDS = 0.5  # LocalParticipantProbe.ask_again: at most this often
 INPUT_BUFFER_BYTES = 4 * 1024 * 1024  # what a participant's discovery socket asks for (enlarge_input_buffers)
 
 
@@ -65,11 +71,10 @@ def is_participant_port(port: int, domain_id: int, bound: Container[int]) -> boo
     return is_metatraffic_port(port, domain_id) and port + USER_PORT_OFFSET in bound
 
 
-def process_bits(prefix: bytes) -> int | None:
-    """The 16 low bits of the process id in a Fast DDS GUID prefix (None for another vendor's)."""
-    if prefix[:2] != FAST_DDS_VENDOR or len(prefix) < 6:
-        return None
-    return int.from_bytes(prefix[4:6], "little")
+def participant_prefix(gid: bytes) -> bytes:
+    """The GUID prefix of the participant of an endpoint or participant GID (RTPS 8.2.4: a participant's
+    endpoints share its 12-byte prefix; rmw's GIDs of a DDS middleware are those GUIDs)."""
+    return gid[:GUID_PREFIX_BYTES]
 
 
 def _own_sockets() -> dict[int, str]:
@@ -119,20 +124,15 @@ def local_participant_count(domain_id: int, tables: tuple[Path, ...] = UDP_TABLE
         return None
 
 
-def ask_local_participants_to_announce(domain_id: int, tables: tuple[Path, ...] = UDP_TABLES) -> int:
-    """Send every participant of another process on this host in ``domain_id`` the announcement of a
-    stand-in participant whose locators are this process's participants' discovery ports, so that each
-    announces itself to them at once (why: roc.ros.spdp). Returns how many were asked (0 where the UDP
-    tables cannot be read)."""
-    try:
-        sockets = metatraffic_sockets(domain_id, tables)
-    except (OSError, IndexError, ValueError):
-        return 0
-    ours = sorted({(_reachable(address), port) for address, port, own in sockets if own and address})
-    peers = sorted({(_reachable(address), port) for address, port, own in sockets if not own and address})
-    if not ours or not peers:
-        return 0
-    message = stand_in_announcement(domain_id, ours)
+def _peer_addresses(sockets: list[tuple[str | None, int, bool]], own: bool) -> list[tuple[str, int]]:
+    """Where to send to the IPv4 ``sockets`` of metatraffic_sockets, this process's own or the others'."""
+    return sorted({(_reachable(address), port) for address, port, ours in sockets if ours == own and address})
+
+
+def _send_stand_in(domain_id: int, locators: list[tuple[str, int]], peers: list[tuple[str, int]]) -> int:
+    """Send each of ``peers`` the announcement of a stand-in participant of ``domain_id`` whose locators
+    are ``locators``; returns to how many it went."""
+    message = stand_in_announcement(domain_id, locators)
     asked = 0
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
         for peer in peers:
@@ -142,6 +142,67 @@ def ask_local_participants_to_announce(domain_id: int, tables: tuple[Path, ...] 
             except OSError:  # gone meanwhile, or a full buffer: that one is heard at its next announcement
                 continue
     return asked
+
+
+def ask_local_participants_to_announce(domain_id: int, tables: tuple[Path, ...] = UDP_TABLES) -> int:
+    """Send every participant of another process on this host in ``domain_id`` the announcement of a
+    stand-in participant whose locators are this process's participants' discovery ports, so that each
+    announces itself to them at once (why: roc.ros.spdp). Returns how many were asked (0 where the UDP
+    tables cannot be read)."""
+    try:
+        sockets = metatraffic_sockets(domain_id, tables)
+    except (OSError, IndexError, ValueError):
+        return 0
+    ours, peers = _peer_addresses(sockets, own=True), _peer_addresses(sockets, own=False)
+    if not ours or not peers:
+        return 0
+    return _send_stand_in(domain_id, ours, peers)
+
+
+class LocalParticipantProbe:
+    """Which participants of other processes on this host are in a domain, by their GUID prefixes: ``ask``
+    sends each of them the announcement of a stand-in participant whose one locator is a socket of the
+    probe's own; each answers at once with its own announcement, whose RTPS header names its GUID prefix
+    (``heard``). Any RTPS vendor's participant answers so (Fast DDS and Cyclone DDS measured: within
+    5 ms), and no vendor's GUID layout is read."""
+
+    def __init__(self, domain_id: int, tables: tuple[Path, ...] = UDP_TABLES) -> None:
+        self.domain_id = domain_id
+        self.tables = tables
+        self._socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self._socket.bind(("127.0.0.1", 0))
+        self._socket.setblocking(False)
+        self._heard: set[bytes] = set()
+        self._asked_at: float | None = None
+
+    def ask(self) -> int:
+        """Ask every participant of another process on this host to announce itself to the probe; returns
+        how many were asked (0 where the UDP tables cannot be read)."""
+        self._asked_at = time.monotonic()
+        try:
+            peers = _peer_addresses(metatraffic_sockets(self.domain_id, self.tables), own=False)
+        except (OSError, IndexError, ValueError):
+            return 0
+        return _send_stand_in(self.domain_id, [self._socket.getsockname()], peers) if peers else 0
+
+    def ask_again(self) -> int:
+        """``ask`` if the last was ASK_AGAIN_SECONDS ago or more (else 0)."""
+        if self._asked_at is not None and time.monotonic() - self._asked_at < ASK_AGAIN_SECONDS:
+            return 0
+        return self.ask()
+
+    def heard(self) -> set[bytes]:
+        """The GUID prefixes of the participants that answered so far."""
+        while True:
+            try:
+                message = self._socket.recv(65536)
+            except (BlockingIOError, InterruptedError):
+                return set(self._heard)
+            if message.startswith(b"RTPS") and len(message) >= RTPS_HEADER_BYTES:
+                self._heard.add(message[8:RTPS_HEADER_BYTES])
+
+    def close(self) -> None:
+        self._socket.close()
 
 
 def enlarge_input_buffers(domain_id: int, size: int = INPUT_BUFFER_BYTES) -> int:
@@ -201,16 +262,15 @@ def _reachable(address: str) -> str:
     return "127.0.0.1" if address == "0.0.0.0" else address
 
 
-def discovered_local_peers(writers: list[Any], pid: int) -> int | None:
-    """How many participants of other processes on this host are among ``writers`` (rclpy endpoint
-    infos of the ``ros_discovery_info`` writers); None when this process's own writer is not among
-    them yet or the middleware is not Fast DDS (its GUID layout is unknown)."""
-    prefixes = {bytes(info.endpoint_gid)[:12] for info in writers}
-    own = {p for p in prefixes if process_bits(p) == pid & 0xFFFF}
-    if not own:
+def local_peers_discovered(expected: int | None, heard: set[bytes], writers: list[Any]) -> bool | None:
+    """Every participant of another process on this host has been discovered: as many answered the probe
+    (``heard``, LocalParticipantProbe) as ``expected`` (local_participant_count) and each has a
+    ``ros_discovery_info`` writer among ``writers`` (rclpy endpoint infos). None when the participants of
+    this host cannot be counted (not Linux)."""
+    if expected is None:
         return None
-    host = next(iter(own))[2:4]
-    return sum(1 for p in prefixes - own if process_bits(p) is not None and p[2:4] == host)
+    discovered = {participant_prefix(bytes(info.endpoint_gid)) for info in writers}
+    return len(heard) >= expected and heard <= discovered
 
 
 @dataclass(frozen=True)
@@ -223,17 +283,14 @@ class Told:
 
 
 def incomplete_participants(writers: list[Any], told: Mapping[bytes, Told], endpoints: set[bytes],
-                            nodes: set[tuple[str, str]], pid: int) -> int:
-    """How many participants of other processes, whose ``ros_discovery_info`` writer is among ``writers``
-    (rclpy endpoint infos), are not wholly discovered yet: their writer's message (``told``, by writer
-    GID) has not come, or it lists a node not among ``nodes`` (namespace, name) or an endpoint whose
-    GID is not among ``endpoints``."""
+                            nodes: set[tuple[str, str]]) -> int:
+    """How many participants whose ``ros_discovery_info`` writer is among ``writers`` (rclpy endpoint
+    infos) are not wholly discovered yet: their message (``told``, by participant GUID prefix) has not
+    come, or it lists a node not among ``nodes`` (namespace, name) or an endpoint whose GID is not among
+    ``endpoints``. This process's own participants count as any other: their messages come to it too."""
     incomplete = 0
     for info in writers:
-        gid = bytes(info.endpoint_gid)
-        if process_bits(gid[:12]) == pid & 0xFFFF:
-            continue
-        latest = told.get(gid)
+        latest = told.get(participant_prefix(bytes(info.endpoint_gid)))
         if latest is None or not latest.nodes <= nodes or not latest.endpoints <= endpoints:
             incomplete += 1
     return incomplete

@@ -22,7 +22,7 @@ from rclpy.serialization import deserialize_message
 from rmw_dds_common.msg import ParticipantEntitiesInfo
 
 from roc.errors import RocError
-from roc.ros.discovery import DISCOVERY_TOPIC, Told
+from roc.ros.discovery import DISCOVERY_TOPIC, Told, participant_prefix
 from roc.ros.native import (
     RET_OK,
     MessageInfo,
@@ -75,15 +75,17 @@ def _told(message: ParticipantEntitiesInfo) -> Told:
 
 
 class DiscoveryInfoReader:
-    """A reader of ``ros_discovery_info`` on ``node``'s participant (other participants' messages only);
-    ``take`` gives each writer's latest, ``close`` destroys it (before the node)."""
+    """A reader of ``ros_discovery_info`` on ``node``'s participant (its own participant's messages too);
+    ``take`` gives each participant's latest, ``close`` destroys it (before the node). A message is taken
+    as the participant it names (its ``gid``): the message info's publisher GID is no GUID on every
+    middleware (Cyclone DDS puts an instance handle there)."""
 
     def __init__(self, node) -> None:
         self._rmw = _rmw()
         self._node = node
         self._rmw_node = rmw_node(node)
         qos = discovery_qos(DEPTH)
-        options = _Options(ignore_local_publications=True)
+        options = _Options(ignore_local_publications=False)
         self._subscription = self._rmw.rmw_create_subscription(
             self._rmw_node, type_support(ParticipantEntitiesInfo), DISCOVERY_TOPIC.encode(), ctypes.byref(qos),
             ctypes.byref(options))
@@ -93,7 +95,7 @@ class DiscoveryInfoReader:
         self._latest: dict[bytes, Told] = {}
 
     def take(self) -> dict[bytes, Told]:
-        """What each writer (by GID) told last, with every message that came since the last take."""
+        """What each participant (by GUID prefix) told last, with every message that came since the last take."""
         taken, info = ctypes.c_bool(), MessageInfo()
         while True:
             result = self._rmw.rmw_take_serialized_message_with_info(
@@ -103,7 +105,7 @@ class DiscoveryInfoReader:
             if not taken.value:
                 return dict(self._latest)
             message = deserialize_message(self._buffer.data(), ParticipantEntitiesInfo)
-            self._latest[bytes(info.publisher_gid.data)] = _told(message)
+            self._latest[participant_prefix(bytes(message.gid.data))] = _told(message)
 
     def close(self) -> None:
         with self._node.handle:

@@ -30,15 +30,17 @@ from rclpy.task import Future
 
 from roc import distribution
 from roc.errors import RocError
+from roc.ros import vendors
 from roc.ros.discovery import (
     DISCOVERY_TOPIC,
     UNKNOWN_NODE,
+    LocalParticipantProbe,
     Told,
     ask_local_participants_to_announce,
-    discovered_local_peers,
     enlarge_input_buffers,
     incomplete_participants,
     local_participant_count,
+    local_peers_discovered,
 )
 from roc.ros.discovery_info import DiscoveryInfoReader
 from roc.ros.params import WRITES, parameter_value
@@ -60,12 +62,12 @@ from roc.ros.type_description import describe
 # QUIET_SECONDS (LOCAL_QUIET_SECONDS when discovery stays on this host: no other host's participant can
 # come then); at the latest after the period (``--spin-time``, default DEFAULT_SPIN_TIME, in
 # roc.ros.protocol so that verbs can read it without rclpy: one Fast DDS announcement period and a
-# margin, all a participant could wait before; without --spin-time, one more announcement period while
-# the graph is known to be incomplete). Measured with ten processes: complete in 20 of 20 runs, where a
-# fixed 3.5 s was needed before.
+# margin, all a participant could wait before; without --spin-time, while the graph is known to be
+# incomplete, what this process's DDS vendor may need more for a participant heard late: one more
+# announcement period on Fast DDS, roc.ros.vendors). Measured with ten processes: complete in 20 of 20
+# runs, where a fixed 3.5 s was needed before.
 QUIET_SECONDS = 0.3
 LOCAL_QUIET_SECONDS = 0.1
-ANNOUNCEMENT_SECONDS = 3.0  # Fast DDS's default period of a participant's announcements
 POLL_SECONDS = 0.05
 SERVICE_TIMEOUT = 5.0
 LOG = logging.getLogger(__name__)  # the daemon writes it to its log; a library adds no handler of its own
@@ -79,6 +81,13 @@ def every_graph_closed() -> bool:
     """No participant of this process's Graphs (the only rclpy contexts roc makes) is left: its process may
     end without the middleware's teardown (roc.cli.process_exit)."""
     return not OPEN_GRAPHS
+
+
+# Why Graph.wait_for_discovery ended: the graph was complete (every participant of this host discovered
+# and wholly known, and quiet); the period ended with the graph complete as far as could be told (other
+# hosts' participants cannot be counted, nor this host's off Linux); or it ended with the graph known to
+# be incomplete
+COMPLETE, PERIOD_ENDED, INCOMPLETE = "complete", "period ended", "incomplete"
 
 
 class NotFound(RocError):
@@ -247,20 +256,24 @@ class Graph:
                       for n, t in sorted(node.get_topic_names_and_types())),
                 tuple((n, tuple(t)) for n, t in sorted(node.get_service_names_and_types())))
 
-    def wait_for_discovery(self, period: float | None = None) -> None:
+    def wait_for_discovery(self, period: float | None = None) -> str:
         """Return once this host's participants are discovered, every participant discovered is wholly
         known (see _complete) and the graph has been unchanged for a quiet time (see QUIET_SECONDS); at
         the latest after ``period``. Without one, after DEFAULT_SPIN_TIME, or, while the graph is known
         to be incomplete (a participant of this host not heard yet, a node or endpoint it told not
-        discovered yet), one more announcement period (ANNOUNCEMENT_SECONDS): what a process heard
-        only at its next periodic announcement needs on a loaded machine."""
+        discovered yet), what this process's DDS vendor may need more for a participant it heard only at
+        its next periodic announcement (roc.ros.vendors: one more announcement period on Fast DDS, on a
+        loaded machine). Returns why it ended: COMPLETE, PERIOD_ENDED or INCOMPLETE."""
         quiet = LOCAL_QUIET_SECONDS if discovery_stays_local() else QUIET_SECONDS
         bound = DEFAULT_SPIN_TIME if period is None else period
-        longest = bound + ANNOUNCEMENT_SECONDS if period is None else period
+        vendor = vendors.of_middleware(middleware())
+        longest = bound + (vendor.late_answer_seconds if vendor else 0.0) if period is None else period
         domain = self.context.get_domain_id()
         reader = DiscoveryInfoReader(self.node)
+        probe = LocalParticipantProbe(domain)
         try:
             start = last_change = time.monotonic()
+            probe.ask()
             last = self.signature()
             while True:
                 time.sleep(POLL_SECONDS)
@@ -272,29 +285,33 @@ class Graph:
                 elapsed = now - start
                 if now - last_change < quiet and elapsed < bound:
                     continue
-                peers = self._local_peers_discovered(domain)
+                peers = self._local_peers_discovered(domain, probe)
                 complete = peers is not False and self._complete(told)
-                if complete and (elapsed >= bound or (peers and now - last_change >= quiet)):
-                    return
+                if complete and peers and now - last_change >= quiet:
+                    return COMPLETE
+                if complete and elapsed >= bound:
+                    return PERIOD_ENDED
                 if elapsed >= longest:
-                    return
+                    return INCOMPLETE
         finally:
+            probe.close()
             reader.close()
 
-    def _local_peers_discovered(self, domain: int) -> bool | None:
-        """Every participant of another process on this host in ``domain`` has been discovered (None
-        when that cannot be told: not Linux, or not Fast DDS)."""
+    def _local_peers_discovered(self, domain: int, probe: LocalParticipantProbe) -> bool | None:
+        """Every participant of another process on this host in ``domain`` has been discovered
+        (roc.ros.discovery.local_peers_discovered; None when that cannot be told: not Linux). While some
+        have not answered ``probe``, it asks them again (one that came since, or whose answer was lost)."""
         expected = local_participant_count(domain)
+        heard = probe.heard()
+        if expected is not None and len(heard) < expected:
+            probe.ask_again()
         writers = self.node.get_publishers_info_by_topic(DISCOVERY_TOPIC, no_mangle=True)
-        discovered = discovered_local_peers(writers, os.getpid())
-        if expected is None or discovered is None:
-            return None
-        return discovered >= expected
+        return local_peers_discovered(expected, heard, writers)
 
     def _complete(self, told: Mapping[bytes, Told]) -> bool:
         """Every endpoint's node is known (a participant seen before its node names is not complete), and
         every participant discovered is wholly known: its latest ``ros_discovery_info`` message
-        (``told``, by writer GID) has come and each node and endpoint it lists has been discovered
+        (``told``, by participant GUID prefix) has come and each node and endpoint it lists has been discovered
         (roc.ros.discovery.incomplete_participants)."""
         node = self.node
         endpoints: set[bytes] = set()
@@ -306,7 +323,7 @@ class Graph:
             endpoints.update(bytes(info.endpoint_gid) for info in found)
         writers = node.get_publishers_info_by_topic(DISCOVERY_TOPIC, no_mangle=True)
         nodes = {(namespace, name) for name, namespace in node.get_node_names_and_namespaces()}
-        return incomplete_participants(writers, told, endpoints, nodes, os.getpid()) == 0
+        return incomplete_participants(writers, told, endpoints, nodes) == 0
 
     # -- roc's own participants (roc.ros.protocol.is_own_node) are in no answer ---------------------------
     def _nodes(self, own: bool = False) -> list[tuple[str, str]]:

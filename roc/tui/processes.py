@@ -18,8 +18,9 @@ from typing import Any
 
 import psutil
 
-from roc.ros.discovery import is_metatraffic_port, process_bits
+from roc.ros.discovery import is_metatraffic_port
 from roc.ros.protocol import full_name
+from roc.ros.vendors.fastdds import process_bits
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,8 @@
 """How a fresh participant knows its graph is complete (roc.ros.discovery, roc.ros.discovery_info) and
-how it asks this host's participants to announce themselves (roc.ros.spdp): unit tests on made-up /proc
-tables and GUIDs; real participants telling their nodes and endpoints on ros_discovery_info; a real
-Fast DDS participant answering the stand-in's announcement."""
+how it asks this host's participants to announce themselves (roc.ros.spdp), whatever their DDS vendor
+(roc.ros.vendors): unit tests on made-up /proc tables and GUIDs; real participants telling their nodes
+and endpoints on ros_discovery_info; a real participant answering the stand-in's announcement; first
+queries on the suite's middleware and in a domain where Fast DDS and Cyclone DDS processes meet."""
 
 from __future__ import annotations
 
@@ -10,25 +11,30 @@ import socket
 import struct
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
 from helpers.graph import NODE_SCRIPT, graph_env, read_line, roc, start_nodes, stop_all
+from helpers.rmw import CYCLONEDDS, FASTRTPS, on_middleware, require_cyclonedds, suite_middleware
 
 from roc import distribution
+from roc.middleware import process_environment
+from roc.ros import vendors
 from roc.ros.discovery import (
     INPUT_BUFFER_BYTES,
+    LocalParticipantProbe,
     Told,
     ask_local_participants_to_announce,
-    discovered_local_peers,
     enlarge_input_buffers,
     incomplete_participants,
     local_participant_count,
+    local_peers_discovered,
     metatraffic_sockets,
     own_socket_inodes,
-    process_bits,
 )
 from roc.ros.spdp import SPDP_WRITER, stand_in_announcement
+from roc.ros.vendors.fastdds import process_bits
 
 SLOT = 67
 
@@ -59,14 +65,30 @@ class Writer:
         self.endpoint_gid = list(bytes.fromhex(prefix_hex + "000001c3"))
 
 
-def test_discovered_peers_are_the_other_fast_dds_participants_of_this_host() -> None:
-    pid = 0x7322
-    ours = Writer("010f7f01" "2273" "2073" "00000000")
-    writers = [ours, Writer("010f7f01" "8272" "ae01" "00000000"), Writer("010f7f01" "8272" "ae01" "01000000"),
-               Writer("010fc0a8" "1111" "0000" "00000000"),  # another host
-               Writer("01107f01" "1111" "0000" "00000000")]  # another vendor
-    assert discovered_local_peers(writers, pid) == 2  # one process, two participants
-    assert discovered_local_peers(writers[1:], pid) is None  # this process's own writer not seen yet
+FAST_DDS_PREFIX = "010f7f01" "8272" "ae01" "00000000"  # host id 7f01, pid bits 0x7282
+CYCLONE_PREFIX = "0110" "26b8a480c105da044b55"  # no host, no pid
+
+
+def test_a_participant_s_vendor_is_told_by_its_guid_prefix_or_its_middleware() -> None:
+    assert vendors.of_prefix(bytes.fromhex(FAST_DDS_PREFIX)).name == "Fast DDS"
+    assert vendors.of_prefix(bytes.fromhex(CYCLONE_PREFIX)).name == "Cyclone DDS"
+    assert vendors.of_prefix(bytes.fromhex("0000" + CYCLONE_PREFIX[4:])) is None
+    assert vendors.of_middleware("rmw_cyclonedds_cpp") == vendors.of_prefix(bytes.fromhex(CYCLONE_PREFIX))
+    assert vendors.of_middleware("rmw_fastrtps_dynamic_cpp").name == "Fast DDS"
+    assert vendors.of_middleware("rmw_zenoh_cpp") is None
+    assert process_bits(bytes.fromhex(FAST_DDS_PREFIX)) == 0x7282  # Fast DDS's layout, in its vendor's module
+    assert process_bits(bytes.fromhex(CYCLONE_PREFIX)) is None
+
+
+def test_this_hosts_peers_are_discovered_once_each_that_answered_the_probe_has_a_discovery_writer() -> None:
+    """Any vendor's prefixes: who is of this host comes from the probe's answers, not from a GUID layout."""
+    fast, cyclone, remote = (bytes.fromhex(p) for p in (FAST_DDS_PREFIX, CYCLONE_PREFIX, "0110" + "ab" * 10))
+    writers = [Writer(prefix.hex()) for prefix in (fast, cyclone, remote)]
+    assert local_peers_discovered(2, {fast, cyclone}, writers) is True
+    assert local_peers_discovered(2, {fast, cyclone}, writers[1:]) is False  # the Fast DDS one not discovered yet
+    assert local_peers_discovered(2, {cyclone}, writers) is False  # one of the two ports has not answered yet
+    assert local_peers_discovered(0, set(), []) is True  # alone on this host
+    assert local_peers_discovered(None, {fast}, writers) is None  # cannot be counted (not Linux)
 
 
 def _told(nodes: list[str], endpoints: list[str]) -> Told:
@@ -75,24 +97,23 @@ def _told(nodes: list[str], endpoints: list[str]) -> Told:
 
 
 def test_a_participant_is_wholly_known_once_its_message_has_come_and_all_it_lists_is_discovered() -> None:
-    pid = 0x7322
-    ours, talker, listener = ("010f7f01" "2273" "2073" "00000000", "010f7f01" "8272" "ae01" "00000000",
-                              "010f7f01" "8272" "b001" "00000000")
+    """What a participant told is keyed by the participant its message names (Cyclone DDS's message info
+    names no writer GUID); this process's own participant is told as any other."""
+    ours, talker, listener = ("0110" "1111aaaa" "22222222" "0000", CYCLONE_PREFIX, FAST_DDS_PREFIX)
     writers = [Writer(prefix) for prefix in (ours, talker, listener)]
-    gid = {writer: bytes(writer.endpoint_gid) for writer in writers}
-    talker_pub, listener_sub = talker + "00000103", listener + "00000104"
-    told = {gid[writers[1]]: _told(["talker"], [talker_pub]), gid[writers[2]]: _told(["listener"], [listener_sub])}
-    nodes = {("/", "talker"), ("/", "listener")}
-    endpoints = {bytes.fromhex(talker_pub), bytes.fromhex(listener_sub)}
-    assert incomplete_participants(writers, told, endpoints, nodes, pid) == 0
+    talker_pub, listener_sub, our_sub = talker + "00000103", listener + "00000104", ours + "00000704"
+    told = {bytes.fromhex(ours): _told(["_roc_1"], [our_sub]), bytes.fromhex(talker): _told(["talker"], [talker_pub]),
+            bytes.fromhex(listener): _told(["listener"], [listener_sub])}
+    nodes = {("/", "talker"), ("/", "listener"), ("/", "_roc_1")}
+    endpoints = {bytes.fromhex(gid) for gid in (talker_pub, listener_sub, our_sub)}
+    assert incomplete_participants(writers, told, endpoints, nodes) == 0
     # the listener's subscription is told but not discovered yet: only the listener is incomplete
-    assert incomplete_participants(writers, told, {bytes.fromhex(talker_pub)}, nodes, pid) == 1
+    assert incomplete_participants(writers, told, endpoints - {bytes.fromhex(listener_sub)}, nodes) == 1
     # a node told that the graph does not show yet
-    assert incomplete_participants(writers, told, endpoints, {("/", "talker")}, pid) == 1
-    # no message from the listener's writer yet; this process's own writer is never waited for
-    assert incomplete_participants(writers, {gid[writers[1]]: told[gid[writers[1]]]}, endpoints, nodes, pid) == 1
-    assert incomplete_participants(writers, {}, set(), set(), pid) == 2
-    assert incomplete_participants(writers, {}, set(), set(), 0x1111) == 3  # another process: ours is a peer
+    assert incomplete_participants(writers, told, endpoints, nodes - {("/", "talker")}) == 1
+    # no message from the listener yet; nor this process's own
+    assert incomplete_participants(writers, {bytes.fromhex(talker): told[bytes.fromhex(talker)]}, endpoints, nodes) == 2
+    assert incomplete_participants(writers, {}, set(), set()) == 3
 
 
 def _locator(address: str, port: int) -> bytes:
@@ -138,6 +159,39 @@ def test_the_other_processes_participants_are_asked_to_announce_themselves_to_ou
     finally:
         ours.close()
         theirs.close()
+
+
+def test_the_probe_hears_the_guid_prefix_of_each_participant_of_this_host_that_answers(tmp_path: Path) -> None:
+    """Domain 202, above the tests' domains: a socket standing in for another process's participant gets
+    the stand-in's announcement, whose locator is the probe's, and answers there as any participant
+    does; the probe names it by the GUID prefix of the answer's RTPS header."""
+    [theirs] = _bound_at_free_participant_ports(202, 1)
+    table = tmp_path / "udp"
+    port = theirs.getsockname()[1]
+    table.write_text(UDP_HEADER + "".join(_udp_line(port + offset, "99", "0100007F") for offset in (0, 1)))
+    probe = LocalParticipantProbe(202, (table,))
+    try:
+        assert probe.heard() == set()
+        assert probe.ask() == 1
+        assert probe.ask_again() == 0  # asked just now
+        theirs.settimeout(5)
+        asked = theirs.recv(65536)
+        at = asked.index(struct.pack("<HH", 0x0032, 24)) + 4  # PID_METATRAFFIC_UNICAST_LOCATOR
+        probe_port, probe_address = struct.unpack("<I", asked[at + 4:at + 8])[0], socket.inet_ntoa(asked[at + 20:at + 24])
+        answer = b"RTPS\x02\x03\x01\x10" + bytes.fromhex(CYCLONE_PREFIX) + bytes(8)
+        theirs.sendto(answer, (probe_address, probe_port))
+        theirs.sendto(b"not RTPS at all", (probe_address, probe_port))
+        for _ in range(100):
+            if probe.heard():
+                break
+            time.sleep(0.05)
+        assert probe.heard() == {bytes.fromhex(CYCLONE_PREFIX)}
+    finally:
+        probe.close()
+        theirs.close()
+    unreadable = LocalParticipantProbe(202, (tmp_path / "missing",))
+    assert unreadable.ask() == 0  # not Linux
+    unreadable.close()
 
 
 def test_this_process_s_discovery_sockets_are_enlarged_and_no_other_socket() -> None:
@@ -311,3 +365,54 @@ def test_a_first_query_waits_for_an_endpoint_a_participant_told_but_never_announ
         stop_all(processes)
     assert "ghost" in seen["nodes"] and "talker" in seen["nodes"]  # the ghost's message did come
     assert seen["waited"] >= 1.0
+
+
+# In a process of its own: a first query's wait (the default period), why it ended, and the nodes it saw
+FIRST_QUERY = """
+import json
+from roc.ros.graph import Graph
+
+graph = Graph()
+why = graph.wait_for_discovery()
+nodes = sorted(name for name, _ in graph.node.get_node_names_and_namespaces())
+graph.close()
+print(json.dumps({"why": why, "nodes": nodes}))
+"""
+TALKER = {"name": "talker", "publishers": [{"topic": "chatter", "type": "std_msgs/msg/String"}]}
+LISTENER = {"name": "listener", "subscribers": [{"topic": "chatter", "type": "std_msgs/msg/String"}]}
+
+
+@pytest.mark.slow
+@pytest.mark.rmw
+def test_a_first_query_on_the_suite_s_middleware_ends_because_the_graph_is_complete(tmp_path: Path) -> None:
+    """On Cyclone DDS (the middleware suite) as on Fast DDS: the wait ends once both processes are wholly
+    known, not when its period runs out (Cyclone's message info and GUIDs are not Fast DDS's)."""
+    if suite_middleware() == CYCLONEDDS:
+        require_cyclonedds()
+    env = graph_env(SLOT, tmp_path)
+    processes = start_nodes([TALKER, LISTENER], env)
+    try:
+        seen = _printed_by(FIRST_QUERY, process_environment(env))
+    finally:
+        stop_all(processes)
+    assert seen["why"] == "complete"
+    assert {"talker", "listener"} <= set(seen["nodes"])
+
+
+@pytest.mark.slow
+def test_first_queries_on_either_middleware_beside_the_other_s_processes_end_because_the_graph_is_complete(
+        tmp_path: Path) -> None:
+    """A mixed domain: a Cyclone DDS talker and a Fast DDS listener. A first query on Fast DDS, and one on
+    Cyclone DDS, each ends once both are wholly known (a Cyclone process made Fast DDS's wait run out)."""
+    require_cyclonedds()
+    env = graph_env(SLOT, tmp_path)
+    processes = [*start_nodes([TALKER], on_middleware(env, CYCLONEDDS)),
+                 *start_nodes([LISTENER], on_middleware(env, FASTRTPS))]
+    try:
+        seen = {middleware: _printed_by(FIRST_QUERY, process_environment(on_middleware(env, middleware)))
+                for middleware in (FASTRTPS, CYCLONEDDS)}
+    finally:
+        stop_all(processes)
+    for middleware, first in seen.items():
+        assert first["why"] == "complete", middleware
+        assert {"talker", "listener"} <= set(first["nodes"]), middleware

@@ -153,7 +153,7 @@ class FakeGraph:
     def _complete(self, told):
         return True
 
-    def _local_peers_discovered(self, domain: int) -> bool | None:
+    def _local_peers_discovered(self, domain: int, probe) -> bool | None:
         if self.peers_at == "uncountable":
             return None
         return self.peers_at is not None and self.clock.now >= self.peers_at
@@ -172,31 +172,67 @@ class FakeReader:
         pass
 
 
-@pytest.mark.parametrize("settles_at, peers_at, period, ends_at", [
-    (0.0, 0.0, 3.5, 0.1),  # quiet and every local participant heard: at once (after the local quiet time)
-    (0.6, 0.2, 3.5, 0.7),  # still changing until 0.6 s: 0.1 s of quiet more
-    (0.0, 1.2, 3.5, 1.2),  # a participant of this host not heard yet: waits for it
-    (0.0, None, 3.5, 3.5),  # one never heard (or not countable): the whole period (--spin-time)
-    (60.0, 0.0, 2.0, 2.0),  # never quiet: the period
-    (0.0, None, None, 6.5),  # without --spin-time, one known unheard: one more announcement period
-    (0.0, 5.0, None, 5.0),  # ... ending when it is heard
-    (0.0, "uncountable", None, 3.5),  # the default period when who is missing cannot be told
-    (60.0, 0.0, None, 3.5),  # never quiet but complete: the default period
+class FakeProbe:
+    """Stands in for roc.ros.discovery.LocalParticipantProbe (FakeGraph tells who has been discovered)."""
+
+    def __init__(self, domain: int) -> None:
+        pass
+
+    def ask(self) -> int:
+        return 0
+
+    def close(self) -> None:
+        pass
+
+
+def _fake_graph(monkeypatch, clock: FakeClock, settles_at: float, peers_at, middleware: str = "rmw_fastrtps_cpp"):
+    from roc.ros import graph as graph_module
+
+    monkeypatch.setattr(graph_module, "time", clock)
+    monkeypatch.setattr(graph_module, "DiscoveryInfoReader", FakeReader)
+    monkeypatch.setattr(graph_module, "LocalParticipantProbe", FakeProbe)
+    monkeypatch.setenv("RMW_IMPLEMENTATION", middleware)
+    fake = FakeGraph(clock, settles_at, peers_at)
+    fake.node = None
+    fake.context = type("Context", (), {"get_domain_id": lambda self: 0})()
+    return fake
+
+
+@pytest.mark.parametrize("settles_at, peers_at, period, ends_at, why", [
+    (0.0, 0.0, 3.5, 0.1, "complete"),  # quiet and every local participant heard: at once (after the local quiet time)
+    (0.6, 0.2, 3.5, 0.7, "complete"),  # still changing until 0.6 s: 0.1 s of quiet more
+    (0.0, 1.2, 3.5, 1.2, "complete"),  # a participant of this host not heard yet: waits for it
+    (0.0, None, 3.5, 3.5, "incomplete"),  # one never heard: the whole period (--spin-time)
+    (60.0, 0.0, 2.0, 2.0, "period ended"),  # never quiet: the period
+    (0.0, None, None, 6.5, "incomplete"),  # without --spin-time, one known unheard: one more announcement period
+    (0.0, 5.0, None, 5.0, "complete"),  # ... ending when it is heard
+    (0.0, "uncountable", None, 3.5, "period ended"),  # the default period when who is missing cannot be told
+    (60.0, 0.0, None, 3.5, "period ended"),  # never quiet but complete: the default period
 ])
 def test_discovery_ends_when_this_hosts_participants_are_heard_and_the_graph_is_quiet(
-        monkeypatch, settles_at, peers_at, period, ends_at):
+        monkeypatch, settles_at, peers_at, period, ends_at, why):
     pytest.importorskip("rclpy")
     from roc.ros import graph as graph_module
 
     clock = FakeClock()
-    monkeypatch.setattr(graph_module, "time", clock)
-    monkeypatch.setattr(graph_module, "DiscoveryInfoReader", FakeReader)
+    fake = _fake_graph(monkeypatch, clock, settles_at, peers_at)
     monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
-    fake = FakeGraph(clock, settles_at, peers_at)
-    fake.node = None
-    fake.context = type("Context", (), {"get_domain_id": lambda self: 0})()
-    graph_module.Graph.wait_for_discovery(fake, period)
+    assert graph_module.Graph.wait_for_discovery(fake, period) == why
     assert clock.now == pytest.approx(ends_at, abs=graph_module.POLL_SECONDS + 1e-9)
+
+
+def test_no_fast_dds_announcement_period_is_waited_for_on_another_middleware(monkeypatch):
+    """Without --spin-time, a participant of this host never heard: Fast DDS waits one more of its
+    announcement periods (3 s); Cyclone DDS and a middleware roc does not know, the default period only."""
+    pytest.importorskip("rclpy")
+    from roc.ros import graph as graph_module
+
+    monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+    for middleware, ends_at in (("rmw_fastrtps_cpp", 6.5), ("rmw_cyclonedds_cpp", 3.5), ("rmw_zenoh_cpp", 3.5)):
+        clock = FakeClock()
+        fake = _fake_graph(monkeypatch, clock, 0.0, None, middleware)
+        assert graph_module.Graph.wait_for_discovery(fake, None) == "incomplete"
+        assert clock.now == pytest.approx(ends_at, abs=graph_module.POLL_SECONDS + 1e-9), middleware
 
 
 def test_beyond_this_host_discovery_waits_longer_for_quiet(monkeypatch):
@@ -204,13 +240,9 @@ def test_beyond_this_host_discovery_waits_longer_for_quiet(monkeypatch):
     from roc.ros import graph as graph_module
 
     clock = FakeClock()
-    monkeypatch.setattr(graph_module, "time", clock)
-    monkeypatch.setattr(graph_module, "DiscoveryInfoReader", FakeReader)
+    fake = _fake_graph(monkeypatch, clock, 0.0, 0.0)
     monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "SUBNET")
-    fake = FakeGraph(clock, 0.0, 0.0)
-    fake.node = None
-    fake.context = type("Context", (), {"get_domain_id": lambda self: 0})()
-    graph_module.Graph.wait_for_discovery(fake, 3.5)
+    assert graph_module.Graph.wait_for_discovery(fake, 3.5) == "complete"
     assert clock.now == pytest.approx(graph_module.QUIET_SECONDS, abs=graph_module.POLL_SECONDS + 1e-9)
 
 

@@ -1,0 +1,24 @@
+"""What differs between DDS vendors, one module per vendor (``fastdds``, ``cyclonedds``), as
+roc/distribution.py holds what differs between distributions: every other module asks ``of_prefix`` (the
+vendor of a participant, from the vendor id its RTPS GUID prefix starts with) or ``of_middleware`` (the
+vendor of an RMW implementation) instead of assuming one vendor's ways. What works for any RTPS vendor
+(the port formula, a stand-in's announcement, GUID prefixes shared by a participant and its endpoints)
+stays in roc.ros.discovery. Plain data: no rclpy."""
+
+from __future__ import annotations
+
+from roc.ros.vendors import cyclonedds, fastdds
+from roc.ros.vendors.vendor import Vendor
+
+VENDORS = (fastdds.VENDOR, cyclonedds.VENDOR)
+
+
+def of_prefix(prefix: bytes) -> Vendor | None:
+    """The vendor of the participant whose GUID prefix (or GID) is ``prefix``; None for another vendor's."""
+    return next((vendor for vendor in VENDORS if prefix[:2] == vendor.vendor_id), None)
+
+
+def of_middleware(name: str) -> Vendor | None:
+    """The vendor of the RMW implementation ``name`` (rmw_fastrtps_cpp, ...); None for a middleware that
+    is no DDS roc knows (rmw_zenoh_cpp, ...)."""
+    return next((vendor for vendor in VENDORS if name in vendor.middlewares), None)

@@ -1,0 +1,15 @@
+"""The facts about a DDS vendor that roc acts on (one instance per vendor module)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Vendor:
+    name: str
+    vendor_id: bytes  # the first two bytes of its participants' GUID prefixes (RTPS 9.3.1.5)
+    middlewares: tuple[str, ...]  # the RMW implementations on it
+    # how much longer a fresh participant of this vendor may need for a participant it heard only at that
+    # participant's next periodic announcement (roc.ros.graph: Graph.wait_for_discovery)
+    late_answer_seconds: float
