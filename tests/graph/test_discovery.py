@@ -400,19 +400,17 @@ def test_a_first_query_on_the_suite_s_middleware_ends_because_the_graph_is_compl
 
 
 @pytest.mark.slow
-def test_first_queries_on_either_middleware_beside_the_other_s_processes_end_because_the_graph_is_complete(
+def test_a_fast_dds_first_query_beside_a_cyclone_dds_process_ends_because_the_graph_is_complete(
         tmp_path: Path) -> None:
-    """A mixed domain: a Cyclone DDS talker and a Fast DDS listener. A first query on Fast DDS, and one on
-    Cyclone DDS, each ends once both are wholly known (a Cyclone process made Fast DDS's wait run out)."""
+    """A mixed domain: a Cyclone DDS talker and a Fast DDS listener. A first query on Fast DDS ends once both
+    are wholly known (the Cyclone process made it wait until its period ran out: 6.5 s)."""
     require_cyclonedds()
     env = graph_env(SLOT, tmp_path)
     processes = [*start_nodes([TALKER], on_middleware(env, CYCLONEDDS)),
                  *start_nodes([LISTENER], on_middleware(env, FASTRTPS))]
     try:
-        seen = {middleware: _printed_by(FIRST_QUERY, process_environment(on_middleware(env, middleware)))
-                for middleware in (FASTRTPS, CYCLONEDDS)}
+        seen = _printed_by(FIRST_QUERY, process_environment(on_middleware(env, FASTRTPS)))
     finally:
         stop_all(processes)
-    for middleware, first in seen.items():
-        assert first["why"] == "complete", middleware
-        assert {"talker", "listener"} <= set(first["nodes"]), middleware
+    assert seen["why"] == "complete"
+    assert {"talker", "listener"} <= set(seen["nodes"])

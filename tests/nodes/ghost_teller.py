@@ -1,8 +1,9 @@
 """A process that tells, on ros_discovery_info, a node whose endpoint nothing announces: node /ghost, with
 one writer GID no participant has, told as its own participant's (a message names the participant it
 tells of, and rmw_dds_common's readers take the latest for each). Its message comes from a writer of its
-own, made through rmw as roc's reader is (rcl cannot name the topic). Prints "ready" once the message
-is published, then sleeps until killed."""
+own, made through rmw as roc's reader is (rcl cannot name the topic), told every 0.1 s: a reader takes
+the latest of the two writers' messages, this one's or rmw's. Prints "ready" once the message is
+published, then tells it again until killed."""
 
 from __future__ import annotations
 
@@ -56,8 +57,9 @@ def main() -> None:
     serialized = SerializedMessage(buffer=buffer, buffer_length=len(data), buffer_capacity=len(data))
     assert rmw.rmw_publish_serialized_message(publisher, ctypes.byref(serialized), None) == 0
     print("ready", flush=True)
-    while True:
-        time.sleep(1)
+    while True:  # told again and again: the latest message of the participant, after the one rmw's writer tells
+        time.sleep(0.1)
+        assert rmw.rmw_publish_serialized_message(publisher, ctypes.byref(serialized), None) == 0
 
 
 if __name__ == "__main__":
