@@ -3,10 +3,10 @@
 #   bash scripts/setup.sh                   .venv         ROS 2 Jazzy (the default)
 #   bash scripts/setup.sh --distro kilted   .venv-kilted  ROS 2 Kilted
 #   bash scripts/setup.sh --with-cpp        .venv, then the C++ stack (rclcpp from source) built by roc on
-#                                           it in .cpp-stack/ (scripts/setup_cpp.sh)
+#                                           it in .cpp-stack/ (scripts/setup_stack.sh cpp)
 #   bash scripts/setup.sh --with-cyclonedds .venv, then Debian's cyclonedds-dev (apt-get, as root) and
 #                                           rmw_cyclonedds built by roc on it in .rmw-stack/
-#                                           (scripts/setup_rmw.sh)
+#                                           (scripts/setup_stack.sh rmw)
 # Each is
 #   - a venv made with python3 -m venv (or $PYTHON -m venv),
 #   - roc installed editable with its test extra (pytest, pytest-xdist, colcon as test oracle),
@@ -117,10 +117,23 @@ setup_test_tools() {
     fi
 }
 
-# The stacks built on the venv that were asked for (--with-cpp, --with-cyclonedds).
+# Cyclone DDS itself for rmw_cyclonedds: Debian's cyclonedds-dev (0.10.2; Jazzy vendors 0.10.5, the same
+# API), installed as the test tools are.
+install_cyclonedds() {
+    dpkg -s cyclonedds-dev >/dev/null 2>&1 && return 0
+    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+        say "installing cyclonedds-dev with apt-get"
+        { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq cyclonedds-dev; } \
+            >/dev/null 2>&1 || die "could not install cyclonedds-dev with apt-get"
+    else
+        die "rmw_cyclonedds needs Cyclone DDS: apt-get install cyclonedds-dev (as root), then run this again"
+    fi
+}
+
+# The stacks built on the venv that were asked for (--with-cpp, --with-cyclonedds: scripts/setup_stack.sh).
 build_stacks() {
-    [ "$WITH_CPP" = 0 ] || bash "$ROOT/scripts/setup_cpp.sh"
-    [ "$WITH_CYCLONEDDS" = 0 ] || bash "$ROOT/scripts/setup_rmw.sh"
+    [ "$WITH_CPP" = 0 ] || bash "$ROOT/scripts/setup_stack.sh" cpp
+    [ "$WITH_CYCLONEDDS" = 0 ] || { install_cyclonedds && bash "$ROOT/scripts/setup_stack.sh" rmw; }
 }
 
 # ---- quick path -------------------------------------------------------------------------

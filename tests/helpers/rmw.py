@@ -17,7 +17,7 @@ from helpers.oracles import REPO, in_ci
 STACK = REPO / ".rmw-stack"
 CYCLONEDDS = "rmw_cyclonedds_cpp"
 FASTRTPS = "rmw_fastrtps_cpp"
-CYCLONEDDS_PREFIX = STACK / "install" / CYCLONEDDS
+CYCLONEDDS_PREFIX = STACK / "stack" / "install" / CYCLONEDDS
 SETUP_COMMAND = "bash scripts/setup.sh --with-cyclonedds"
 MISSING = f"rmw_cyclonedds is not built: run {SETUP_COMMAND}"
 

@@ -27,7 +27,7 @@ def test_rmw_cyclonedds_is_a_middleware_of_the_ament_index_and_its_library_resol
 
 def test_an_unchanged_rmw_stack_has_nothing_to_build() -> None:
     require_cyclonedds()
-    explained = subprocess.run([str(BIN / "roc"), "-C", str(STACK), "work", "build", "--explain",
+    explained = subprocess.run([str(BIN / "roc"), "-C", str(STACK / "stack"), "work", "build", "--explain",
                                 "--cmake-args", "-DCMAKE_BUILD_TYPE=Release", "-DBUILD_TESTING=OFF"],
                                env=ros_env(), capture_output=True, text=True, timeout=60)
     assert explained.returncode == 0, explained.stderr
