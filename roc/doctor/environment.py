@@ -15,6 +15,7 @@ from roc.ament_index import resources
 from roc.doctor import build_tools, wheel_defects, wheel_repairs
 from roc.doctor.findings import Finding
 from roc.environment import ament_prefixes, own_prefix, path_list
+from roc.ros import vendors
 
 CATEGORY = "environment"
 DEFAULT_RMW = "rmw_fastrtps_cpp"
@@ -66,7 +67,8 @@ def middleware(env: Mapping[str, str]) -> Finding:
         return Finding(CATEGORY, "middleware", "error", f"RMW_IMPLEMENTATION is {chosen}, which is not installed "
                        f"(installed: {', '.join(installed)})", f"unset RMW_IMPLEMENTATION or install {chosen}")
     default = "" if env.get("RMW_IMPLEMENTATION") else " (the default)"
-    return Finding(CATEGORY, "middleware", "ok", f"{chosen}{default}", details={"installed": installed})
+    return Finding(CATEGORY, "middleware", "ok", f"{chosen}{default}; discovery: {vendors.discovery_of(chosen)}",
+                   details={"installed": installed})
 
 
 def domain(env: Mapping[str, str]) -> Finding:

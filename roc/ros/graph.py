@@ -186,8 +186,9 @@ class Graph:
         rclpy.init(args=[], context=self.context, signal_handler_options=SignalHandlerOptions.NO, domain_id=domain_id)
         OPEN_GRAPHS.add(id(self))
         self.node = self.task_node(node_name or own_node_name(os.getpid()), arguments)
-        enlarge_input_buffers(self.context.get_domain_id())
-        ask_local_participants_to_announce(self.context.get_domain_id())
+        if vendors.speaks_rtps(middleware()):  # DDS's discovery ports and announcements (not rmw_zenoh's)
+            enlarge_input_buffers(self.context.get_domain_id())
+            ask_local_participants_to_announce(self.context.get_domain_id())
         self.events = events
         self.executor = EventsExecutor(context=self.context) if events else SingleThreadedExecutor(context=self.context)
         self._stopping = threading.Event()
@@ -270,10 +271,11 @@ class Graph:
         longest = bound + (vendor.late_answer_seconds if vendor else 0.0) if period is None else period
         domain = self.context.get_domain_id()
         reader = DiscoveryInfoReader(self.node)
-        probe = LocalParticipantProbe(domain)
+        probe = LocalParticipantProbe(domain) if vendors.speaks_rtps(middleware()) else None
         try:
             start = last_change = time.monotonic()
-            probe.ask()
+            if probe is not None:
+                probe.ask()
             last = self.signature()
             while True:
                 time.sleep(POLL_SECONDS)
@@ -294,13 +296,17 @@ class Graph:
                 if elapsed >= longest:
                     return INCOMPLETE
         finally:
-            probe.close()
+            if probe is not None:
+                probe.close()
             reader.close()
 
-    def _local_peers_discovered(self, domain: int, probe: LocalParticipantProbe) -> bool | None:
+    def _local_peers_discovered(self, domain: int, probe: LocalParticipantProbe | None) -> bool | None:
         """Every participant of another process on this host in ``domain`` has been discovered
-        (roc.ros.discovery.local_peers_discovered; None when that cannot be told: not Linux). While some
-        have not answered ``probe``, it asks them again (one that came since, or whose answer was lost)."""
+        (roc.ros.discovery.local_peers_discovered; None when that cannot be told: not Linux, or no ``probe``
+        on a middleware without RTPS). While some have not answered ``probe``, it asks them again (one
+        that came since, or whose answer was lost)."""
+        if probe is None:
+            return None
         expected = local_participant_count(domain)
         heard = probe.heard()
         if expected is not None and len(heard) < expected:

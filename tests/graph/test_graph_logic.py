@@ -321,3 +321,13 @@ def test_roc_s_participants_take_roc_s_profile_unless_the_user_chose(environment
     assert environment.get("FASTRTPS_DEFAULT_PROFILES_FILE") == ours.get(chosen, chosen)
     for profile in (PARTICIPANT_PROFILE, BRIDGE_PROFILE):  # every roc participant announces itself every 0.5 s
         assert "<leaseAnnouncement><sec>0</sec><nanosec>500000000</nanosec></leaseAnnouncement>" in profile.read_text()
+
+
+def test_only_middlewares_that_speak_rtps_get_port_counting_and_stand_in_announcements() -> None:
+    from roc.ros import vendors
+
+    assert vendors.speaks_rtps("rmw_fastrtps_cpp") and vendors.speaks_rtps("rmw_cyclonedds_cpp")
+    assert vendors.speaks_rtps("rmw_connextdds")  # a DDS roc has no module for: still RTPS
+    assert not vendors.speaks_rtps("rmw_zenoh_cpp")
+    assert vendors.discovery_of("rmw_zenoh_cpp").startswith("Zenoh")
+    assert vendors.discovery_of("rmw_cyclonedds_cpp").startswith("DDS")

@@ -11,6 +11,19 @@ from roc.ros.vendors import cyclonedds, fastdds
 from roc.ros.vendors.vendor import Vendor
 
 VENDORS = (fastdds.VENDOR, cyclonedds.VENDOR)
+# Middlewares whose discovery is not DDS's (no RTPS ports, no SPDP announcements, no ros_discovery_info):
+# roc sends them no stand-in announcement and counts no participants by port.
+NOT_RTPS = {"rmw_zenoh_cpp": "Zenoh (a router, or peers scouting by multicast)"}
+
+
+def discovery_of(middleware: str) -> str:
+    """How the participants of ``middleware`` find each other, in a few words (roc doctor says it)."""
+    return NOT_RTPS.get(middleware, "DDS (RTPS participant announcements)")
+
+
+def speaks_rtps(middleware: str) -> bool:
+    """Whether ``middleware``'s participants discover each other with RTPS (every DDS; not rmw_zenoh)."""
+    return middleware not in NOT_RTPS
 
 
 def of_prefix(prefix: bytes) -> Vendor | None:
