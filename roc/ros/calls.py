@@ -51,6 +51,7 @@ def call(graph, params: dict[str, Any]) -> Events:
     value?}`` per call; with ``rate`` (Hz) again and again until closed."""
     cls = service_class(params["type"])
     request, plain = _received(params, "request", cls.Request), "request_data" in params
+    graph.refuse_crashing_request(params["service"])
     client = graph.node.create_client(cls, params["service"])
     try:
         if not client.wait_for_service(timeout_sec=0.1):

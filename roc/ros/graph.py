@@ -123,6 +123,10 @@ def _endpoint(info) -> dict[str, Any]:
     }
 
 
+class CrashRisk(RocError):
+    """A request roc does not send: it is known to crash the node that would get it."""
+
+
 def _service_endpoint(info) -> dict[str, Any]:
     """An endpoint of a service's request or reply topic, its DDS type name (``std_srvs::srv::dds_::
     SetBool_Request_``) given as ROS names it (``std_srvs/srv/SetBool_Request``)."""
@@ -476,8 +480,19 @@ class Graph:
                     raise NotFound("Node not found") from None
             time.sleep(POLL_SECONDS)
 
+    def refuse_crashing_request(self, service: str) -> None:
+        """Raise CrashRisk when a server of ``service`` runs on a middleware that a request from this
+        process's is known to crash (roc.ros.vendors.request_crash: Cyclone DDS to Fast DDS)."""
+        for info in self.node.get_subscriptions_info_by_topic(f"rq{service}Request", no_mangle=True):
+            reason = vendors.request_crash(middleware(), bytes(info.endpoint_gid))
+            if reason:
+                node = full_name(info.node_namespace, info.node_name)
+                raise CrashRisk(f"{node}: not asked: {reason}; ask from a process on its middleware "
+                                f"(RMW_IMPLEMENTATION=rmw_fastrtps_cpp)")
+
     def call_node_service(self, node_name: str, service: str, srv_type, request) -> Any:
         """Call the node's service ``service`` (e.g. ``set_parameters``) and return the response."""
+        self.refuse_crashing_request(f"{node_name.rstrip('/')}/{service}")
         client = self.node.create_client(srv_type, f"{node_name.rstrip('/')}/{service}")
         try:
             if not client.wait_for_service(timeout_sec=SERVICE_TIMEOUT):
@@ -527,16 +542,22 @@ class Graph:
 
     def param_list(self, node_name: str | None, prefixes: list[str] | None, with_types: bool,
                    hidden: bool = False) -> list[dict]:
-        """[{node, parameters: [{name, type?}]}] for one node or every node (``hidden``: hidden nodes too)."""
+        """[{node, parameters: [{name, type?}]}] for one node or every node (``hidden``: hidden nodes too);
+        a node not asked, since the request could crash it, has ``left_out`` (why) and no parameters."""
         graph = self.snapshot()
         served = {s["name"] for s in graph["services"]}  # a node without parameter services is left out at once
         names = [node_name] if node_name else [n["full_name"] for n in graph["nodes"]
                                                if (hidden or not n["name"].startswith("_"))
                                                and f"{n['full_name']}/list_parameters" in served]
-        result = []
+        result: list[dict[str, Any]] = []
         for name in names:
             try:
                 params = self.param_names(name, prefixes)
+            except CrashRisk as risk:
+                if node_name:
+                    raise
+                result.append({"node": name, "parameters": [], "left_out": str(risk)})
+                continue
             except RocError:
                 if node_name:
                     raise

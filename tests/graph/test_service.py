@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import shutil
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -223,8 +224,10 @@ def _built_demo_interfaces(workspace: Path, env: dict[str, str]) -> dict[str, st
     """demo_interfaces of the example workspace built by roc into ``workspace``: the environment of a shell
     that sourced it (a robot that has the package; roc's own environment does not)."""
     shutil.copytree(REPO / "workspaces" / "example" / "src" / "demo_interfaces", workspace / "src" / "demo_interfaces")
-    built = subprocess.run([str(BIN / "roc"), "work", "build"], cwd=workspace, env=env, capture_output=True,
-                           text=True, timeout=600)
+    # built on the wheels alone: with the oracle's venv first, CMake would take its python3, which need not
+    # have ament_package
+    built = subprocess.run([str(BIN / "roc"), "work", "build"], cwd=workspace, env={**env, "AMENT_PREFIX_PATH": sys.prefix},
+                           capture_output=True, text=True, timeout=600)
     assert built.returncode == 0, built.stdout + built.stderr
     sourced = subprocess.run(["bash", "-c", "source install/setup.bash && env -0"], cwd=workspace, env=env,
                              capture_output=True, text=True, timeout=60)

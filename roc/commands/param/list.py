@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import argparse
 import re
+import sys
 
 from roc.cli.options import add_graph_arguments
 from roc.commands.graph_query import ask
 from roc.commands.param.target import absolute_node_name
 from roc.errors import RocError, UsageError
-from roc.render import render
+from roc.render import print_text, render
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -39,6 +40,10 @@ def run(args: argparse.Namespace) -> int:
     matches = _matching(args.filter_regex)
     nodes = ask(args, "param_list", {"node": args.node_name, "prefixes": args.param_prefixes,
                                      "types": args.param_type, "hidden": args.include_hidden_nodes})
+    left_out = [entry for entry in nodes if entry.get("left_out")]
+    if left_out:  # nodes the request could crash (a mixed domain): said once, not asked
+        print_text(f"roc: warning: left out {', '.join(e['node'] for e in left_out)}: "
+                   f"{left_out[0]['left_out'].split(': not asked: ', 1)[-1]}\n", sys.stderr)
     for entry in nodes:
         entry["parameters"] = [p for p in entry["parameters"] if matches(p["name"])]
     if not args.node_name:  # as ros2, a node none of whose parameters is listed is left out

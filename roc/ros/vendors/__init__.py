@@ -16,6 +16,15 @@ VENDORS = (fastdds.VENDOR, cyclonedds.VENDOR)
 NOT_RTPS = {"rmw_zenoh_cpp": "Zenoh (a router, or peers scouting by multicast)"}
 
 
+def request_crash(client_middleware: str, server_prefix: bytes) -> str | None:
+    """Why a service request from a client of ``client_middleware`` must not go to a server whose
+    participant GUID prefix (or endpoint GID) is ``server_prefix`` (it is known to crash it), else None."""
+    client, server = of_middleware(client_middleware), of_prefix(server_prefix)
+    if client is None or server is None or server.vendor_id not in client.crashes_servers_of:
+        return None
+    return f"a {client.name} request can crash a {server.name} node ({client.crash_report})"
+
+
 def discovery_of(middleware: str) -> str:
     """How the participants of ``middleware`` find each other, in a few words (roc doctor says it)."""
     return NOT_RTPS.get(middleware, "DDS (RTPS participant announcements)")

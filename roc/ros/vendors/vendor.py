@@ -13,3 +13,6 @@ class Vendor:
     # how much longer a fresh participant of this vendor may need for a participant it heard only at that
     # participant's next periodic announcement (roc.ros.graph: Graph.wait_for_discovery)
     late_answer_seconds: float
+    # the vendor ids of servers a request of this vendor's clients is known to crash
+    crashes_servers_of: tuple[bytes, ...] = ()
+    crash_report: str = ""  # where that is told
