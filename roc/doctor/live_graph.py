@@ -9,6 +9,7 @@ from collections.abc import Callable
 from typing import Any
 
 from roc.doctor.findings import Finding
+from roc.ros import vendors
 from roc.ros.present import is_hidden, qos_problems, topic_problems
 
 CATEGORY = "graph"
@@ -63,7 +64,28 @@ def checks(ask: Ask) -> tuple[list[Finding], dict[str, Any]]:
                                     f"{topic['name']}.", details={"topic": topic["name"]}))
     if not lonely:
         findings.append(Finding(CATEGORY, "topics", "ok", "every topic has publishers and subscribers"))
+    findings.append(middlewares(ask))
     return findings, {"graph": graph, "endpoints": endpoints}
+
+
+def middlewares(ask: Ask) -> Finding:
+    """The middlewares of the graph's nodes, told by the vendor id of their /rosout publishers' GIDs: a
+    mixed domain (Fast DDS and Cyclone DDS nodes) works, but has a known way to crash a node."""
+    try:
+        rosout = ask("topic_endpoints", {"topic": "/rosout"})["publishers"]
+    except Exception:  # noqa: BLE001 - no node publishes /rosout
+        rosout = []
+    nodes: Counter[str] = Counter()
+    for endpoint in rosout:
+        vendor = vendors.of_prefix(bytes(int(part, 16) for part in endpoint["gid"].split(".")[:2]))
+        nodes[vendor.name if vendor else "another middleware"] += 1
+    if len(nodes) <= 1:
+        return Finding(CATEGORY, "middlewares", "ok", f"every node on {next(iter(nodes), 'one middleware')}")
+    counts = ", ".join(f"{count} node(s) on {name}" for name, count in sorted(nodes.items()))
+    return Finding(CATEGORY, "middlewares", "warning", f"a mixed domain: {counts}; topics interoperate, but a "
+                   "Cyclone DDS client's service request can crash a Fast DDS node (ros2/rmw_cyclonedds#577), so "
+                   "roc on Cyclone DDS asks no Fast DDS node", "run every process on one middleware "
+                   "(RMW_IMPLEMENTATION), or ask Fast DDS nodes from a process on Fast DDS")
 
 
 def reports(asked: dict[str, Any]) -> dict[str, list[tuple[str, str]]]:

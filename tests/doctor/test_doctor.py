@@ -137,11 +137,11 @@ def test_doctor_finds_what_is_wrong_with_a_graph(doctor_env):
                 "RELIABLE\n") in text.stdout
         assert "  warning  topics: Publisher without subscriber detected on /chatter.\n" in text.stdout
         assert "  warning  topics: Subscriber without publisher detected on /cmd.\n" in text.stdout
-        assert text.stdout.endswith("/16 check(s) failed\n\nFailed modules: graph\n")
+        assert text.stdout.endswith("/17 check(s) failed\n\nFailed modules: graph\n")
         data = json.loads(roc("doctor", "--format", "json", env=env).stdout)
         assert data["failed_categories"] == ["graph"] and data["errors"] == 2
         assert {(f["check"], f["level"]) for f in data["findings"] if f["category"] == "graph"} == {
-            ("node names", "error"), ("qos", "error"), ("topics", "warning")}
+            ("node names", "error"), ("qos", "error"), ("topics", "warning"), ("middlewares", "ok")}
         failed = roc("doctor", "--report-failed", env=env).stdout
         assert "\n   QOS COMPATIBILITY LIST\ntopic [type]            : /scan [std_msgs/msg/String]\n" in failed
         assert "PLATFORM INFORMATION" not in failed and "NETWORK CONFIGURATION" not in failed
@@ -156,7 +156,7 @@ def test_doctor_passes_a_healthy_graph_and_reports(doctor_env):
         healthy = roc("doctor", env=env)
         assert healthy.returncode == 0, healthy.stdout
         assert "graph:\n  ok       node names: 2 node(s), each named once\n" in healthy.stdout
-        assert healthy.stdout.endswith("\nAll 16 checks passed\n")
+        assert healthy.stdout.endswith("\nAll 17 checks passed\n")
         assert roc("wtf", env=env).returncode == 0  # ros2's alias
         report = roc("doctor", "--report", env=env)
         assert report.returncode == 0

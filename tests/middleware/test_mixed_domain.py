@@ -53,3 +53,15 @@ def test_roc_on_cyclone_dds_sends_no_request_to_a_fast_dds_node(tmp_path: Path) 
         stop_daemon(on_cyclone)
         stop_daemon(on_fast)
         stop_all([*fast, *cyclone])
+
+
+def test_doctor_reports_a_mixed_domain() -> None:
+    from roc.doctor.live_graph import middlewares
+
+    def ask(gids):
+        return lambda method, params: {"publishers": [{"gid": gid} for gid in gids]}
+    fast, cyclone = "01.0f.7f.01.f3.5f.00.00.01.00.00.00.00.00.01.03", "01.10.45.12.ab.cd.00.00.01.00.00.00.00.00.01.03"
+    assert middlewares(ask([fast, fast])).message == "every node on Fast DDS"
+    mixed = middlewares(ask([fast, cyclone, fast]))
+    assert mixed.level == "warning"
+    assert mixed.message.startswith("a mixed domain: 1 node(s) on Cyclone DDS, 2 node(s) on Fast DDS; ")
