@@ -105,12 +105,16 @@ def values(graph, params: dict[str, Any]) -> Events:
             due = time.monotonic() + params.get("period", 0.0)
             while len(batch) < MAX_BATCH and (remaining := due - time.monotonic()) > 0:
                 batch += receiver.batch(remaining, MAX_BATCH - len(batch))
-            lost, times, decoded = 0, [], []
+            lost: int | None = 0  # None: unknown, where the middleware gives no sequence numbers (Cyclone DDS)
+            times, decoded = [], []
             for _, data, info in batch:
                 sequence, gid = info.get("publication_sequence_number"), info.get("gid", "")
                 previous = last_sequence.get(gid)
-                if sequence is not None:
-                    lost += max(0, sequence - previous - 1) if previous is not None else 0
+                if sequence is None:
+                    lost = None
+                else:
+                    if lost is not None and previous is not None:
+                        lost += max(0, sequence - previous - 1)
                     last_sequence[gid] = sequence
                 times.append(info.get("source_timestamp") or info.get("received_timestamp") or time.time_ns())
                 decoded.append(deserialize_message(data, cls))

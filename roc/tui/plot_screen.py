@@ -71,7 +71,8 @@ class PlotScreen(Screen):
         self.window = 10
         self.paused_at: float | None = None  # the latest time shown while paused
         self.latest = 0.0  # the newest sample's time
-        self.received = self.lost = 0
+        self.received = 0
+        self.lost: int | None = 0
         self.errors: dict[str, str] = {}
         self.inbox: deque[tuple[str, dict]] = deque()  # (topic, samples event), from the streams' threads
         self.changed = True  # something to draw
@@ -128,7 +129,8 @@ class PlotScreen(Screen):
             if one.topic == topic and one.path in event["values"]:
                 one.add(times, event["values"][one.path])
         self.received += len(times)
-        self.lost += event.get("lost", 0)
+        lost = event.get("lost", 0)
+        self.lost = None if lost is None or self.lost is None else self.lost + lost  # None: unknown (Cyclone DDS)
         if times:
             self.latest = max(self.latest, times[-1])
             self.changed = self.changed or self.paused_at is None
@@ -137,7 +139,8 @@ class PlotScreen(Screen):
         state = "paused (Space: resume)" if self.paused_at is not None else "live (Space: pause)"
         errors = "  ".join(f"{topic}: {error}" for topic, error in self.errors.items())
         self.query_one("#title", Static).update(Text(
-            f"plot, last {self.window} s, {state}  {self.received} samples, {self.lost} lost  {errors}", style="bold"))
+            f"plot, last {self.window} s, {state}  {self.received} samples, "
+            f"{'unknown' if self.lost is None else self.lost} lost  {errors}", style="bold"))
 
     def draw(self) -> None:
         self.changed, self.drawn_at = False, time.monotonic()

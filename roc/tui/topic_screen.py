@@ -46,7 +46,8 @@ def stats_text(window: Window) -> str:
         return "rate: waiting for messages"
     return (f"rate {rate_text(rate['rate'])} (min {rate['min']:.3f} s, max {rate['max']:.3f} s, std dev "
             f"{rate['std_dev']:.5f} s, window {rate['window']})  "
-            f"bandwidth {bandwidth_text(bandwidth['bytes_per_second'])}  lost {window.lost}")
+            f"bandwidth {bandwidth_text(bandwidth['bytes_per_second'])}  "
+            f"lost {'unknown' if window.known_lost() is None else window.lost}")
 
 
 class TopicScreen(Screen):
