@@ -30,6 +30,7 @@ from rclpy.qos import (
 from rclpy.serialization import deserialize_message
 
 from roc.errors import RocError
+from roc.ros import vendors
 from roc.ros.content_filter import ContentFilter
 from roc.ros.messages import value_to_data
 from roc.ros.protocol import HEARTBEAT_SECONDS, Events, full_name, task_node_name
@@ -371,17 +372,24 @@ def _transforms(message: Any) -> list[list]:
 
 class PublisherNames:
     """The full names of the nodes behind publisher gids on a topic, from the graph (looked up again,
-    at most every POLL_SECONDS, when a gid is not known yet)."""
+    at most every POLL_SECONDS, when a gid is not known yet). Where the middleware gives no writer GUID
+    with a message (Cyclone DDS: an instance handle, roc.ros.vendors.cyclonedds), a message is named
+    only while its topic has one publishing node, and is unnamed (None) when several publish it."""
 
     def __init__(self, graph) -> None:
         self._graph = graph
         self._names: dict[tuple[str, str], str] = {}
+        self._only: dict[str, str | None] = {}  # each topic's one publishing node (None: several, or none)
         self._looked: dict[str, float] = {}
 
     def name(self, topic: str, gid: str) -> str | None:
         if (topic, gid) not in self._names and time.monotonic() - self._looked.get(topic, 0.0) >= POLL_SECONDS:
             self._looked[topic] = time.monotonic()
-            for info in self._graph.node.get_publishers_info_by_topic(topic):
-                if info.node_name != "_NODE_NAME_UNKNOWN_":
-                    self._names[topic, gid_text(info.endpoint_gid)] = full_name(info.node_namespace, info.node_name)
-        return self._names.get((topic, gid))
+            now = {gid_text(info.endpoint_gid): full_name(info.node_namespace, info.node_name)
+                   for info in self._graph.node.get_publishers_info_by_topic(topic)
+                   if info.node_name != "_NODE_NAME_UNKNOWN_"}
+            self._names.update({(topic, known): name for known, name in now.items()})
+            self._only[topic] = next(iter(set(now.values()))) if len(set(now.values())) == 1 else None
+        if (topic, gid) in self._names:
+            return self._names[topic, gid]
+        return self._only.get(topic) if vendors.of_prefix(bytes.fromhex(gid.replace(".", ""))) is None else None
