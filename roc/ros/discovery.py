@@ -40,7 +40,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from roc.ros.spdp import stand_in_announcement
+from roc.ros.spdp import announced_properties, stand_in_announcement
 
 PORT_BASE = 7400
 DOMAIN_GAIN = 250
@@ -172,7 +172,7 @@ class LocalParticipantProbe:
         self._socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self._socket.bind(("127.0.0.1", 0))
         self._socket.setblocking(False)
-        self._heard: set[bytes] = set()
+        self._heard: dict[bytes, dict[str, str]] = {}  # GUID prefix -> the properties it announced
         self._asked_at: float | None = None
 
     def ask(self) -> int:
@@ -193,13 +193,19 @@ class LocalParticipantProbe:
 
     def heard(self) -> set[bytes]:
         """The GUID prefixes of the participants that answered so far."""
+        return set(self.announced())
+
+    def announced(self) -> dict[bytes, dict[str, str]]:
+        """What the participants that answered so far announced: the properties of each (spdp.
+        announced_properties: Cyclone DDS names its host and process there), by GUID prefix."""
         while True:
             try:
                 message = self._socket.recv(65536)
             except (BlockingIOError, InterruptedError):
-                return set(self._heard)
+                return dict(self._heard)
             if message.startswith(b"RTPS") and len(message) >= RTPS_HEADER_BYTES:
-                self._heard.add(message[8:RTPS_HEADER_BYTES])
+                prefix = message[8:RTPS_HEADER_BYTES]
+                self._heard[prefix] = announced_properties(message) or self._heard.get(prefix, {})
 
     def close(self) -> None:
         self._socket.close()

@@ -1,5 +1,6 @@
 """The one RTPS message roc writes itself: a participant announcement (SPDP DATA(p), RTPS 2.3 8.5.3 and
-9.6.2) of a short-lived stand-in participant that names roc's own participant's discovery port.
+9.6.2) of a short-lived stand-in participant that names roc's own participant's discovery port; and the
+one thing roc reads of the announcements that answer it, their properties (``announced_properties``).
 
 Why: a Fast DDS participant (2.14 and 3.x alike) sends its first announcement before it listens
 (RTPSParticipantImpl::enable), so the announcements other participants send back at once to the newcomer
@@ -36,6 +37,8 @@ PID_DEFAULT_UNICAST_LOCATOR = 0x0031
 PID_METATRAFFIC_UNICAST_LOCATOR = 0x0032
 PID_PARTICIPANT_GUID = 0x0050
 PID_BUILTIN_ENDPOINT_SET = 0x0058
+PID_PROPERTY_LIST = 0x0059
+FLAG_LITTLE_ENDIAN, FLAG_INLINE_QOS = 0x01, 0x02
 PARTICIPANT_ANNOUNCER_AND_DETECTOR = 0x3  # the only builtin endpoints the stand-in has
 LEASE_SECONDS = 1
 
@@ -70,3 +73,63 @@ def stand_in_announcement(domain_id: int, locators: list[tuple[str, int]]) -> by
     body = struct.pack("<HH", 0, 16) + SPDP_READER + SPDP_WRITER + sequence_number + PL_CDR_LE + b"".join(parameters)
     submessage = bytes([SUBMESSAGE_DATA, FLAGS_LITTLE_ENDIAN_WITH_DATA]) + struct.pack("<H", len(body)) + body
     return b"RTPS" + PROTOCOL_VERSION + VENDOR_UNKNOWN + prefix + submessage
+
+
+def announced_properties(message: bytes) -> dict[str, str]:
+    """The properties (PID_PROPERTY_LIST) of the participant announcement in an RTPS message, {} when it
+    holds none. Cyclone DDS names its participant's host and process there (``__Hostname``, ``__Pid``,
+    ``__ProcessName``), which no rmw call tells."""
+    offset = 20  # after the RTPS header
+    if not message.startswith(b"RTPS"):
+        return {}
+    try:
+        while offset + 4 <= len(message):
+            kind, flags = message[offset], message[offset + 1]
+            order = "<" if flags & FLAG_LITTLE_ENDIAN else ">"
+            (length,) = struct.unpack_from(order + "H", message, offset + 2)
+            body, offset = offset + 4, (len(message) if length == 0 else offset + 4 + length)
+            if kind == SUBMESSAGE_DATA and message[body + 8:body + 12] == SPDP_WRITER:
+                (to_inline_qos,) = struct.unpack_from(order + "H", message, body + 2)
+                payload = body + 4 + to_inline_qos
+                if flags & FLAG_INLINE_QOS:
+                    payload = _parameters_end(message, payload, order)
+                return _properties(message, payload)
+    except (struct.error, IndexError, UnicodeDecodeError):
+        pass
+    return {}
+
+
+def _parameters_end(message: bytes, offset: int, order: str) -> int:
+    """Where the parameter list starting at ``offset`` ends (after its sentinel)."""
+    while True:
+        pid, length = struct.unpack_from(order + "HH", message, offset)
+        offset += 4 + length
+        if pid == PID_SENTINEL:
+            return offset
+
+
+def _properties(message: bytes, payload: int) -> dict[str, str]:
+    """The PID_PROPERTY_LIST of the serialized parameter list (PL_CDR_LE or _BE) at ``payload``."""
+    order = "<" if message[payload + 1] == 0x03 else ">"
+    offset = payload + 4
+    while offset + 4 <= len(message):
+        pid, length = struct.unpack_from(order + "HH", message, offset)
+        if pid == PID_SENTINEL:
+            break
+        if pid == PID_PROPERTY_LIST:
+            (count,) = struct.unpack_from(order + "I", message, offset + 4)
+            at, found = offset + 8, {}
+            for _ in range(count):
+                name, at = _string(message, at, order)
+                value, at = _string(message, at, order)
+                found[name] = value
+            return found
+        offset += 4 + length
+    return {}
+
+
+def _string(message: bytes, offset: int, order: str) -> tuple[str, int]:
+    """A CDR string (its length with the NUL, the bytes, padding to 4) at ``offset``; and where it ends."""
+    (length,) = struct.unpack_from(order + "I", message, offset)
+    text = message[offset + 4:offset + 4 + length].rstrip(b"\0").decode()
+    return text, offset + 4 + length + (-length % 4)

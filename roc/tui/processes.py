@@ -1,41 +1,47 @@
 """Which process runs each node, and its CPU and memory (psutil), for the nodes on this host.
 
-Fast DDS 2.14 writes the process into every participant's GUID prefix (rtps/common/GuidUtils.hpp):
-bytes 0-1 the vendor (01.0f, eProsima), 2-3 a host id, 4-5 the 16 low bits of the process id (little
-endian), 6-7 random, 8-11 a counter of the process's participants. An endpoint's gid starts with its
-participant's prefix, so each node's /rosout or /parameter_events publisher names its process: a local
-process whose pid has those 16 low bits and which holds a metatraffic unicast port of the domain (UDP
-7400 + 250 * domain + 10 + 2 * k, the RTPS default Fast DDS uses; k is the first index free on the
-host, not the counter) is the one. A node whose participant no local process holds runs on another
-host (or in another network namespace).
+An endpoint's gid starts with its participant's GUID prefix, so each node's /rosout or /parameter_events
+publisher names its participant, and the participant its process:
+- Fast DDS 2.14 writes the process into every participant's GUID prefix (roc.ros.vendors.fastdds): the
+  16 low bits of the process id. A local process whose pid has those bits and which holds a metatraffic
+  unicast port of the domain (UDP 7400 + 250 * domain + 10 + 2 * k, the RTPS default Fast DDS uses; k is
+  the first index free on the host, not the counter) is the one.
+- Cyclone DDS writes no process into its GUIDs, but a participant announces its host name and process id
+  (``__Hostname``, ``__Pid``): roc asks this host's participants to announce themselves to a socket of its
+  own (roc.ros.discovery.LocalParticipantProbe), a few times at most, and reads them there.
+A node whose participant no local process holds or tells runs on another host (or in another network
+namespace).
 """
 
 from __future__ import annotations
 
 import os
+import socket
+from collections import Counter
 from dataclasses import dataclass
 from typing import Any
 
 import psutil
 
-from roc.ros.discovery import is_metatraffic_port
+from roc.ros.discovery import LocalParticipantProbe, is_metatraffic_port
 from roc.ros.protocol import full_name
 from roc.ros.vendors.fastdds import process_bits
+
+ASKS = 3  # how often the participants of this host are asked to announce themselves for one participant
 
 
 @dataclass(frozen=True)
 class Participant:
     prefix: str  # the GUID prefix, 12 bytes as dotted hex
-    pid_bits: int  # the 16 low bits of its process id
+    pid_bits: int | None  # Fast DDS: the 16 low bits of its process id; None for another vendor's
 
 
 def participant(gid: str) -> Participant | None:
-    """The participant of an endpoint gid (``01.0f.7f.01.f3.5f...``), None when it is not Fast DDS's."""
+    """The participant of an endpoint gid (``01.0f.7f.01.f3.5f...``), None when it is no GUID."""
     parts = gid.split(".")
-    bits = process_bits(bytes(int(part, 16) for part in parts[:12])) if len(parts) >= 12 else None
-    if bits is None:
+    if len(parts) < 12:
         return None
-    return Participant(".".join(parts[:12]), bits)
+    return Participant(".".join(parts[:12]), process_bits(bytes(int(part, 16) for part in parts[:12])))
 
 
 def node_participants(snapshot: dict[str, Any]) -> dict[str, Participant]:
@@ -70,6 +76,8 @@ class Processes:
     def __init__(self, domain: int | None = None) -> None:
         self.domain = domain if domain is not None else int(os.environ.get("ROS_DOMAIN_ID") or 0)
         self._found: dict[str, psutil.Process | None] = {}  # participant prefix -> its process
+        self._probe: LocalParticipantProbe | None = None  # made for the first participant not Fast DDS's
+        self._asked: Counter[str] = Counter()  # participant prefix -> how often the probe asked for it
         self.usage: dict[str, Usage] = {}  # node -> usage
 
     def locate(self, found: Participant) -> psutil.Process | None:
@@ -77,6 +85,8 @@ class Processes:
             cached = self._found[found.prefix]
             if cached is None or cached.is_running():
                 return cached
+        if found.pid_bits is None:
+            return self._announced_process(found)
         process = None
         for pid in psutil.pids():
             if pid & 0xFFFF != found.pid_bits:
@@ -89,6 +99,26 @@ class Processes:
                     break
             except (psutil.NoSuchProcess, psutil.AccessDenied, psutil.ZombieProcess):
                 continue
+        self._found[found.prefix] = process
+        return process
+
+    def _announced_process(self, found: Participant) -> psutil.Process | None:
+        """The process a participant announced as its own on this host (Cyclone DDS: ``__Pid`` and
+        ``__Hostname``); None until its answer comes (by a later update), and for good after ASKS asks."""
+        if self._probe is None:
+            self._probe = LocalParticipantProbe(self.domain)
+        announced = self._probe.announced().get(bytes.fromhex(found.prefix.replace(".", "")), {})
+        pid = announced.get("__Pid", "")
+        if not announced or announced.get("__Hostname") != socket.gethostname() or not pid.isdigit():
+            if announced or self._asked[found.prefix] >= ASKS:
+                self._found[found.prefix] = None  # another host's, or it tells no process
+            elif self._probe.ask_again():
+                self._asked[found.prefix] += 1
+            return None
+        try:
+            process: psutil.Process | None = psutil.Process(int(pid))
+        except psutil.Error:
+            process = None
         self._found[found.prefix] = process
         return process
 

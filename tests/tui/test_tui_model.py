@@ -155,7 +155,9 @@ def test_a_participant_gid_names_its_process_bits_and_a_domain_port() -> None:
 
     found = participant("01.0f.7f.01.f3.5f.c1.23.00.00.00.00.00.00.03.03")
     assert found is not None and found.pid_bits == 0x5FF3 and found.prefix == "01.0f.7f.01.f3.5f.c1.23.00.00.00.00"
-    assert participant("01.10.00.00.00.00.00.00.00.00.00.00.00.00.00.00") is None  # not Fast DDS's
+    other = participant("01.10.00.00.00.00.00.00.00.00.00.00.00.00.00.00")  # Cyclone DDS's: no process in it
+    assert other is not None and other.pid_bits is None and other.prefix == "01.10.00.00.00.00.00.00.00.00.00.00"
+    assert participant("01.10.00") is None  # no GUID
     assert is_metatraffic_port(8660, 5) and is_metatraffic_port(8664, 5)
     assert not is_metatraffic_port(8661, 5) and not is_metatraffic_port(7410, 5)
 
