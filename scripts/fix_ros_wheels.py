@@ -14,7 +14,9 @@ import os
 import sys
 from pathlib import Path
 
-from roc.doctor import wheel_repairs
+# roc from this checkout, also for a venv that has the wheels but not roc (the tests' ros2 CLI oracle)
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from roc.doctor import wheel_repairs  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -32,6 +32,10 @@ set -euo pipefail
 ROOT="$(cd -- "$(dirname -- "${BASH_SOURCE[0]}")/.." && pwd -P)"
 PYTHON="${PYTHON:-python3}"
 
+# The set-up runs on the wheels' own middleware: their librcl links Fast DDS and exits at load (102) when
+# RMW_IMPLEMENTATION names another, as a user's shell may.
+unset RMW_IMPLEMENTATION
+
 say() { printf 'setup: %s\n' "$*" >&2; }
 die() { printf 'setup: error: %s\n' "$*" >&2; exit 1; }
 

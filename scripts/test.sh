@@ -7,8 +7,8 @@
 # --with-cpp (first) builds the C++ stack (scripts/setup.sh --with-cpp), then runs the C++ suite (tests
 # marked cpp); the whole suite runs them too once the stack is built, and skips them while it is not:
 #   bash scripts/test.sh --with-cpp
-# --rmw cyclonedds|fastrtps (first) runs the middleware suite (tests marked rmw) with RMW_IMPLEMENTATION
-# naming that middleware; cyclonedds first builds rmw_cyclonedds (scripts/setup.sh --with-cyclonedds):
+# --rmw cyclonedds|fastrtps (first) runs the middleware suite (tests marked rmw), the graphs and roc's
+# processes they start with RMW_IMPLEMENTATION naming that middleware; cyclonedds first builds rmw_cyclonedds (scripts/setup.sh --with-cyclonedds):
 #   bash scripts/test.sh --rmw cyclonedds
 # (tests/conftest.py: on a distribution other than Jazzy only the tests marked distro run).
 set -euo pipefail
@@ -29,7 +29,9 @@ case "${1:-}" in
             fastrtps) ;;
             *) echo "test: error: --rmw needs a middleware: cyclonedds or fastrtps" >&2; exit 2 ;;
         esac
-        export RMW_IMPLEMENTATION="rmw_${2}_cpp"
+        # for the processes the tests start (tests/helpers/rmw.py): pytest's own stay on the wheels' Fast
+        # DDS, which their librcl links and checks as it loads (exit 102 on another RMW_IMPLEMENTATION)
+        export ROC_TEST_RMW="rmw_${2}_cpp"
         marker=rmw; shift 2 ;;
 esac
 if [ "$distro" = jazzy ]; then venv="$ROOT/.venv"; else venv="$ROOT/.venv-$distro"; fi

@@ -125,7 +125,7 @@ def test_what_frame_pub_publishes_is_listed_under_a_node_named_for_it_as_ros2_li
     """roc frame pub publishes from the daemon, on a node of its own, /roc_frame_pub_<pid> (issue 51: on the
     daemon's hidden node, roc's lists left /tf_static out, which ros2 lists). A domain of its own: no
     other /tf_static publisher."""
-    env = with_tf2_msgs(graph_env(7, tmp_path))
+    env = with_tf2_msgs(graph_env(54, tmp_path))
     pub = subprocess.Popen([str(BIN / "roc"), "frame", "pub", "map", "odom"], env=env, stdout=subprocess.PIPE,
                            stderr=subprocess.DEVNULL, text=True)
     node = f"roc_frame_pub_{pub.pid}"

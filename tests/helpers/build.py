@@ -9,7 +9,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from helpers.rmw import middleware_prefixes
+from helpers.rmw import middleware_prefixes, suite_environment
 from roc import distribution
 
 REPO = Path(__file__).resolve().parents[2]
@@ -30,6 +30,7 @@ def ros_env(**extra: str) -> dict[str, str]:
     underlay."""
     env = {k: v for k, v in os.environ.items() if k not in ("COLCON_PREFIX_PATH", "AMENT_PREFIX_PATH")}
     env["AMENT_PREFIX_PATH"] = os.pathsep.join([*middleware_prefixes(), sys.prefix])
+    env.update(suite_environment())
     env["PATH"] = f"{BIN}{os.pathsep}{env.get('PATH', '/usr/bin:/bin')}"
     env.update(extra)
     return env

@@ -15,7 +15,7 @@ from pathlib import Path
 from helpers.build import BIN, DISTRO, REQUIREMENTS, ros_domain_id, stop_process
 from helpers.build import roc as roc_build
 from helpers.oracles import SHARED, require_oracle
-from helpers.rmw import middleware_prefixes
+from helpers.rmw import middleware_prefixes, suite_environment
 from roc.middleware import process_environment
 
 NODE_SCRIPT = Path(__file__).resolve().parents[1] / "nodes" / "graph_node.py"
@@ -47,7 +47,7 @@ def graph_env(slot: int, runtime_dir: Path, **extra: str) -> dict[str, str]:
     env.pop("ROS_LOCALHOST_ONLY", None)
     env.update(ROS_DOMAIN_ID=ros_domain_id(slot), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
                XDG_RUNTIME_DIR=str(runtime_dir), AMENT_PREFIX_PATH=os.pathsep.join([*middleware_prefixes(), str(ORACLE_VENV), sys.prefix]),
-               PATH=f"{BIN}{os.pathsep}{env.get('PATH', '/usr/bin:/bin')}")
+               PATH=f"{BIN}{os.pathsep}{env.get('PATH', '/usr/bin:/bin')}", **suite_environment())
     env.update(extra)
     return env
 
@@ -195,6 +195,12 @@ def _install_ros2cli() -> str | None:
                            capture_output=True, text=True, timeout=900)
     if added.returncode != 0:
         return f"installing {' '.join(pins)} into the oracle failed: {added.stderr.strip()[-300:]}"
+    # its message packages' CMake exports repaired as the suite's venv's are: a build whose AMENT_PREFIX_PATH
+    # names the oracle first (graph_env) takes them from there
+    repaired = subprocess.run([str(ORACLE_VENV / "bin" / "python"), str(REPO / "scripts" / "fix_ros_wheels.py"),
+                               "--quiet"], capture_output=True, text=True, timeout=300)
+    if repaired.returncode != 0:
+        return f"fix_ros_wheels.py in the oracle failed: {(repaired.stderr or repaired.stdout).strip()[-300:]}"
     return None
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from helpers.build import BIN, FIXTURES, stop_process
 from helpers.graph import ORACLE_VENV, graph_env, roc
-from helpers.rmw import middleware_prefixes
+from helpers.rmw import middleware_prefixes, suite_environment
 
 SITE = f"lib/python{sys.version_info.major}.{sys.version_info.minor}/site-packages"
 DEMO_NODES = {"/robot1/talker", "/robot1/listener", "/map_server"}
@@ -48,6 +48,7 @@ def demo_env(slot: int, runtime: Path, prefix: Path, **extra: str) -> dict[str, 
     """The test's ROS domain with roc_launch_demo sourced over the wheels (and the oracle's venv)."""
     env = graph_env(slot, runtime, **extra)
     env["AMENT_PREFIX_PATH"] = os.pathsep.join([str(prefix), *middleware_prefixes(), str(ORACLE_VENV), sys.prefix])
+    env.update(suite_environment())
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(prefix / SITE), env.get("PYTHONPATH")]))
     env.pop("ROC_LAUNCH_ID", None)
     return env

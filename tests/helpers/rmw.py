@@ -1,5 +1,5 @@
 """The middleware suite (tests marked ``rmw``): ``bash scripts/test.sh --rmw cyclonedds`` runs them with
-RMW_IMPLEMENTATION=rmw_cyclonedds_cpp, on the rmw_cyclonedds that ``bash scripts/setup.sh
+ROC_TEST_RMW=rmw_cyclonedds_cpp (the processes they start get RMW_IMPLEMENTATION=rmw_cyclonedds_cpp), on the rmw_cyclonedds that ``bash scripts/setup.sh
 --with-cyclonedds`` builds with roc in .rmw-stack/; the whole suite runs them on Fast DDS, the wheels' own.
 A test that needs rmw_cyclonedds (the suite's, or a Cyclone process beside Fast DDS ones) calls
 ``require_cyclonedds``: without the build it is skipped with the reason ``rmw_cyclonedds is not built:
@@ -23,8 +23,15 @@ MISSING = f"rmw_cyclonedds is not built: run {SETUP_COMMAND}"
 
 
 def suite_middleware() -> str:
-    """The RMW this run's graph tests use: RMW_IMPLEMENTATION's (test.sh --rmw), Fast DDS without it."""
-    return os.environ.get("RMW_IMPLEMENTATION") or FASTRTPS
+    """The RMW this run's graph tests use: ROC_TEST_RMW's (test.sh --rmw), Fast DDS without it. pytest's
+    own processes stay on the wheels' Fast DDS (their librcl links it and checks RMW_IMPLEMENTATION as it
+    loads); the processes the tests start get it (``suite_environment``)."""
+    return os.environ.get("ROC_TEST_RMW") or FASTRTPS
+
+
+def suite_environment() -> dict[str, str]:
+    """What an environment the helpers make for a test's processes takes of the suite's middleware."""
+    return {"RMW_IMPLEMENTATION": suite_middleware()} if os.environ.get("ROC_TEST_RMW") else {}
 
 
 def require_cyclonedds() -> Path:

@@ -37,7 +37,8 @@ def _run_probe_suite(tmp_path: Path, shared: Path, workers: int = 0, **extra: st
     tests/conftest.py and the helpers it loads, the oracles looked up in ``shared``."""
     suite = tmp_path / "suite"
     (suite / "helpers").mkdir(parents=True)
-    for name in ("conftest.py", "helpers/__init__.py", "helpers/oracles.py", "helpers/build.py"):
+    for name in ("conftest.py", "helpers/__init__.py", "helpers/oracles.py", "helpers/build.py", "helpers/cpp.py",
+                 "helpers/rmw.py"):
         shutil.copy(REPO / "tests" / name, suite / name)
     (suite / "test_probe.py").write_text(PROBE_TESTS)
     env = {k: v for k, v in os.environ.items() if k not in ("CI", "PYTEST_ADDOPTS")}

@@ -136,7 +136,7 @@ def test_an_image_topic_drawn_live_paused_and_a_compressed_one_from_the_palette(
             await open_row(app, pilot, "topics", "/chatter")
             await until(pilot, lambda: screen_name(app) == "TopicScreen" and app.screen.type_name is not None)
             await pilot.press("i")  # no image: said, and the topic stays
-            await until(pilot, lambda: any("is no image topic" in str(n.message) for n in app._notifications),
+            await until(pilot, lambda: any("is no image, scan or grid topic" in str(n.message) for n in app._notifications),
                         what="the warning")
             assert screen_name(app) == "TopicScreen"
     asyncio.run(test())

@@ -129,7 +129,7 @@ def test_a_live_laserscan_and_occupancy_grid_drawn(tmp_path) -> None:
                 await pilot.press("escape")
                 await until(pilot, lambda: app.screen is app.graph_screen, what="back")
 
-    with live_graph(graph_env(67, tmp_path), []) as env:
+    with live_graph(graph_env(56, tmp_path), []) as env:
         publisher = subprocess.Popen([sys.executable, "-c", PUBLISHER], env=env, stdout=subprocess.PIPE, text=True)
         try:
             assert publisher.stdout.readline().strip() == "ready"

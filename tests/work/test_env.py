@@ -27,7 +27,7 @@ def test_env_prints_only_what_the_build_environment_changes(tmp_path: Path) -> N
     printed = roc("work", "env", "beta", cwd=tmp_path, env=env)
     assert printed.returncode == 0, printed.stderr
     names = [line.split("=", 1)[0] for line in printed.stdout.splitlines()]
-    assert names == ["export CMAKE_PREFIX_PATH"], printed.stdout
+    assert names == ["export CMAKE_PREFIX_PATH", "export PYTHONHASHSEED"], printed.stdout  # the fixed hash seed
     assert str(tmp_path / "install" / "alpha") in printed.stdout
     everything = roc("work", "env", "beta", "--all", cwd=tmp_path, env=env)
     assert "export PATH=" in everything.stdout and "export ROC_TEST_UNRELATED=1" in everything.stdout
