@@ -295,8 +295,15 @@ class _Work:
 
     def _build_tree(self, workspace: Workspace, options: BuildOptions) -> None:
         """Build the package here without the remote cache (a build tree, not an install, is wanted);
-        nothing to do in the folder of this key's build."""
+        nothing to do in the folder of this key's build. A package this folder only restored (a dependency
+        of another package built here) has an install and a state but no build tree: its state goes, so
+        it is built."""
         from roc.builder.plan import plan_build
+        from roc.builder.state import STATE_FILE
+
+        build_dir = options.build_base / self.work.name
+        if not (build_dir / "CMakeCache.txt").is_file():
+            (build_dir / STATE_FILE).unlink(missing_ok=True)
 
         execute(plan_build(workspace, options, None, {}), [self.recorder], 1, stop=self.stop)
         if self.recorder.failures:
