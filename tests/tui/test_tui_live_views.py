@@ -72,12 +72,15 @@ def test_nodes_and_topics_side_by_side_with_cpu_rates_and_only_real_problems(gra
             # the real problems, and none for /rosout or /parameter_events (nobody subscribes to them)
             problems = lambda: [p.text for p in app.graph_screen.problems]  # noqa: E731
             await until(pilot, lambda: any("below the 50 Hz" in p for p in problems()), what="the rate problem")
+            await until(pilot, lambda: any(p.startswith("/diagnostics ") for p in problems()),
+                        what="the diagnostics' ERROR")  # start_tui_nodes' battery status
             texts = problems()
             assert any(p.startswith("/odd: QoS incompatible (reliability)") for p in texts), texts
             assert "/cmd_vel: no publisher" in texts
             assert not any(p.startswith(("/rosout", "/parameter_events", "/pose", "/talker")) for p in texts), texts
-            assert len(texts) == 3, texts
-            assert "3 problems" in str(app.screen.query_one("#problems").render())
+            assert "/diagnostics power: battery: ERROR empty (:diagnostics)" in texts
+            assert len(texts) == 4, texts
+            assert "4 problems" in str(app.screen.query_one("#problems").render())
             picture(app, "system")
             # a node that dies is a problem, and p goes to it
             stop_all([mortal])
