@@ -102,7 +102,10 @@ def test_nodes_and_topics_side_by_side_with_cpu_rates_and_only_real_problems(gra
             await until_screen(app, pilot, lambda s: "/chatter" in s and "/chatty_logger" in s, "both lists at 80x24")
             lines = screen_lines(app)
             assert len(lines) <= 24 and max(len(line) for line in lines) <= 80
-    asyncio.run(test())
+    try:
+        asyncio.run(test())
+    finally:
+        stop_all([mortal])  # a failing test leaves no node behind (stopped in the test already: a no-op)
     assert os.environ.get("ROS_DOMAIN_ID")  # the app ran in the graph's environment
 
 
