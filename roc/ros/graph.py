@@ -483,6 +483,9 @@ class Graph:
     def refuse_crashing_request(self, service: str) -> None:
         """Raise CrashRisk when a server of ``service`` runs on a middleware that a request from this
         process's is known to crash (roc.ros.vendors.request_crash: Cyclone DDS to Fast DDS)."""
+        client = vendors.of_middleware(middleware())
+        if client is None or not client.crashes_servers_of:  # nothing to look up on every other middleware
+            return
         for info in self.node.get_subscriptions_info_by_topic(f"rq{service}Request", no_mangle=True):
             reason = vendors.request_crash(middleware(), bytes(info.endpoint_gid))
             if reason:

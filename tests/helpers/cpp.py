@@ -9,9 +9,7 @@ import os
 import subprocess
 from pathlib import Path
 
-import pytest
-
-from helpers.oracles import REPO, in_ci
+from helpers.oracles import REPO, skip_or_fail
 
 STACK = REPO / ".cpp-stack"
 INSTALL = STACK / "stack" / "install"
@@ -22,9 +20,7 @@ MISSING = f"the C++ stack is not built: run {SETUP_COMMAND}"
 def require_stack() -> Path:
     """The stack's install base; skips the test (fails it in CI) when the stack is not built."""
     if not (STACK / "ready").is_file():
-        if in_ci():
-            pytest.fail(f"{MISSING} (CI builds it before the tests)", pytrace=False)
-        pytest.skip(MISSING)
+        skip_or_fail(MISSING, "CI builds it before the tests")
     return INSTALL
 
 

@@ -19,12 +19,16 @@ def in_ci() -> bool:
     return os.environ.get("CI", "").lower() not in ("", "0", "false", "no")
 
 
+def skip_or_fail(message: str, in_ci_because: str) -> None:
+    """Skip the test for want of something, saying ``message``; in CI, which must have it, fail it."""
+    if in_ci():
+        pytest.fail(f"{message} ({in_ci_because})", pytrace=False)
+    pytest.skip(message)
+
+
 def require_oracle(what: str, path: Path) -> Path:
     """``path``, which the test needs; when it does not exist, skip the test (fail it in CI)."""
     if not path.exists():
-        message = MISSING.format(what=what, path=path)
-        if in_ci():
-            pytest.fail(f"{message} (CI must have every oracle: set ROC_TEST_SHARED or check out ../shared)",
-                        pytrace=False)
-        pytest.skip(message)
+        skip_or_fail(MISSING.format(what=what, path=path),
+                     "CI must have every oracle: set ROC_TEST_SHARED or check out ../shared")
     return path

@@ -10,9 +10,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-import pytest
-
-from helpers.oracles import REPO, in_ci
+from helpers.oracles import REPO, skip_or_fail
 
 STACK = REPO / ".rmw-stack"
 CYCLONEDDS = "rmw_cyclonedds_cpp"
@@ -37,9 +35,7 @@ def suite_environment() -> dict[str, str]:
 def require_cyclonedds() -> Path:
     """rmw_cyclonedds' install prefix; skips the test (fails it in CI) when it is not built."""
     if not (STACK / "ready").is_file():
-        if in_ci():
-            pytest.fail(f"{MISSING} (CI builds it before the middleware suite)", pytrace=False)
-        pytest.skip(MISSING)
+        skip_or_fail(MISSING, "CI builds it before the middleware suite")
     return CYCLONEDDS_PREFIX
 
 
