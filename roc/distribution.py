@@ -7,17 +7,15 @@ index has first (AMENT_PREFIX_PATH, then roc's own Python environment: roc.envir
 else ROS_DISTRO. Two distributions in one environment (an overlay built on one, sourced on top of the
 other, chains the first's rclpy in) are a mix (``mix``). roc's build base records the distribution it
 was built with (``MARKER``, ``built_with``), so a workspace built on one distribution is not built
-again on the other. A mix is refused before rclpy is loaded (``refuse_mix``, ``guard_rclpy_import``):
-one distribution's rclpy on the other's libraries crashes the process. Plain files: no rclpy, nothing
-imported from ROS."""
+again on the other. A mix is refused before rclpy is loaded (``refuse_mix``, called by roc.rclpy_guard
+where rclpy is imported): one distribution's rclpy on the other's libraries crashes the process. Plain
+files: no rclpy, nothing imported from ROS."""
 
 from __future__ import annotations
 
 import os
 import re
-import sys
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from collections.abc import Mapping
 from pathlib import Path
 
 from roc.environment import ament_prefixes
@@ -26,14 +24,24 @@ from roc.errors import RocError
 MARKER = ".roc_ros_distribution"  # in a build base roc built in: the distribution's name
 
 
-@dataclass(frozen=True)
 class Distribution:
-    """A ROS 2 distribution and the facts about it that roc acts on."""
+    """A ROS 2 distribution and the facts about it that roc acts on. A plain class: every command that
+    reads package conditions imports this module, and dataclasses would cost each some 8 ms."""
 
-    name: str
-    fastdds_major: int  # 2: Fast DDS 2 (Jazzy's libfastrtps), 3: Fast DDS 3 (Kilted's libfastdds)
-    # the variable Fast DDS reads its XML profiles file from (Kilted's rmw warns about Fast DDS 2's)
-    profiles_variable: str
+    __slots__ = ("name", "fastdds_major", "profiles_variable")
+
+    def __init__(self, name: str, fastdds_major: int, profiles_variable: str):
+        self.name = name
+        # 2: Fast DDS 2 (Jazzy's libfastrtps), 3: Fast DDS 3 (Kilted's libfastdds)
+        self.fastdds_major = fastdds_major
+        # the variable Fast DDS reads its XML profiles file from (Kilted's rmw warns about Fast DDS 2's)
+        self.profiles_variable = profiles_variable
+
+    def renamed(self, name: str) -> Distribution:
+        return Distribution(name, self.fastdds_major, self.profiles_variable)
+
+    def __repr__(self) -> str:
+        return f"Distribution({self.name!r}, fastdds_major={self.fastdds_major})"
 
 
 JAZZY = Distribution("jazzy", fastdds_major=2, profiles_variable="FASTRTPS_DEFAULT_PROFILES_FILE")
@@ -52,7 +60,7 @@ def named(name: str) -> Distribution:
         if known.name == name:
             return known
     older = {"humble", "iron", *END_OF_LIFE}
-    return replace(JAZZY if name in older else SUPPORTED[-1], name=name)
+    return (JAZZY if name in older else SUPPORTED[-1]).renamed(name)
 
 
 def rclpy_version(prefix: Path) -> str | None:
@@ -127,30 +135,6 @@ def refuse_mix(environ: Mapping[str, str] | None = None) -> None:
     if mixed:
         raise MixedDistributions(f"two ROS 2 distributions are sourced: {mixed}; use a new shell that sources "
                                  "one of them, and only workspaces built on it")
-
-
-class _RclpyImportGuard:
-    """A finder first on ``sys.meta_path`` that lets rclpy be imported only once ``refuse_mix`` passed, and
-    after the middleware RMW_IMPLEMENTATION names is loaded where librcl would load another
-    (roc.middleware.load_chosen): it sees every import of rclpy, whichever module asks (the graph, bags, the
-    bridge, the TUI, launch)."""
-
-    def find_spec(self, name: str, path: Sequence[str] | None = None, target: object = None) -> None:
-        if name == "rclpy":
-            from roc.middleware import load_chosen
-
-            refuse_mix()  # raises before any of rclpy's libraries is loaded
-            load_chosen()
-            sys.meta_path.remove(self)
-        return None  # the ordinary finders find it
-
-
-def guard_rclpy_import() -> None:
-    """Refuse, as a one-line error, every import of rclpy in this process while two distributions are
-    sourced; without it, one's rclpy loaded on the other's libraries fails in C (rcutils errors,
-    std::bad_array_new_length) and the process dies of a segmentation fault."""
-    if "rclpy" not in sys.modules and not any(isinstance(f, _RclpyImportGuard) for f in sys.meta_path):
-        sys.meta_path.insert(0, _RclpyImportGuard())
 
 
 def built_with(build_base: Path) -> str | None:

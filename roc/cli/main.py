@@ -71,7 +71,7 @@ def main(argv: list[str] | None = None) -> int:
     debug = os.environ.get("ROC_DEBUG") == "1" or "--debug" in (argv if argv is not None else sys.argv[1:])
     path: tuple[str, ...] = ()
     try:
-        from roc.distribution import guard_rclpy_import
+        from roc.rclpy_guard import guard_rclpy_import
 
         guard_rclpy_import()  # two distributions sourced: a one-line error where a verb would load rclpy
         argv = list(sys.argv[1:] if argv is None else argv)

@@ -11,11 +11,12 @@ finalizers, standard streams flushed) and ends the process at once. Otherwise it
 
 from __future__ import annotations
 
-import atexit
 import os
 import sys
-import threading
-from typing import NoReturn
+
+TYPE_CHECKING = False  # typing and threading cost every command's start-up, and only a graph's end needs them
+if TYPE_CHECKING:
+    from typing import NoReturn
 
 
 def finish(code: int) -> NoReturn:
@@ -23,6 +24,9 @@ def finish(code: int) -> NoReturn:
     graph = sys.modules.get("roc.ros.graph")  # loaded only by commands that reached the ROS graph
     if graph is None or not graph.every_graph_closed():
         sys.exit(code)
+    import atexit
+    import threading
+
     for thread in threading.enumerate():
         if thread is not threading.main_thread() and not thread.daemon:
             thread.join()

@@ -155,7 +155,8 @@ def test_every_distribution_gets_its_facts() -> None:
 
 GUARDED_IMPORT = """
 import sys
-from roc.distribution import MixedDistributions, guard_rclpy_import
+from roc.distribution import MixedDistributions
+from roc.rclpy_guard import guard_rclpy_import
 guard_rclpy_import()
 try:
     import rclpy.node
