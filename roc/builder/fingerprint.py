@@ -17,7 +17,6 @@ import hashlib
 import json
 import os
 import re
-import shutil
 import sys
 from pathlib import Path
 
@@ -38,32 +37,35 @@ FileStamps = dict[str, list]  # relative path -> [size, mtime_ns, sha256, execut
 
 def source_stamps(directory: Path, previous: FileStamps) -> FileStamps:
     """The stamps of the package's files (hidden and ignored directories and editor droppings skipped;
-    symlinks followed, each real directory once)."""
+    symlinks followed, each real directory once). Plain strings, not Paths: this runs for every file of
+    every package on a no-op build."""
     stamps: FileStamps = {}
     seen: set[tuple[int, int]] = set()
-    for dirpath, dirnames, filenames in os.walk(directory, followlinks=True):
+    top = str(directory)
+    for dirpath, dirnames, filenames in os.walk(top, followlinks=True):
         info = os.stat(dirpath)
         real = (info.st_dev, info.st_ino)  # cheaper than realpath, which stats every component
-        if real in seen or (any(m in filenames for m in IGNORE_MARKERS) and dirpath != str(directory)):
+        if real in seen or (any(m in filenames for m in IGNORE_MARKERS) and dirpath != top):
             dirnames.clear()
             continue
         seen.add(real)
         dirnames[:] = [d for d in dirnames if not d.startswith(".") and d != "__pycache__"]
+        below = dirpath[len(top) + 1:]  # os.walk joins names onto ``top``: the folder relative to it
         for name in filenames:
             if name.endswith(".pyc") or EDITOR_DROPPINGS.match(name):
                 continue
-            path = Path(dirpath, name)
-            relative = os.path.relpath(path, directory)
+            path = os.path.join(dirpath, name)
+            relative = os.path.join(below, name) if below else name
             try:
-                info = path.stat()  # a symlink counts by what it points to
+                info = os.stat(path)  # a symlink counts by what it points to
             except OSError:
-                stamps[relative] = [0, 0, "dangling:" + os.readlink(path) if path.is_symlink() else "", False]
+                stamps[relative] = [0, 0, "dangling:" + os.readlink(path) if os.path.islink(path) else "", False]
                 continue
             old = previous.get(relative)
             if old and old[0] == info.st_size and old[1] == info.st_mtime_ns:
                 content = old[2]
             else:
-                content = file_sha256(path)
+                content = file_sha256(Path(path))
             stamps[relative] = [info.st_size, info.st_mtime_ns, content, bool(info.st_mode & 0o100)]
     return stamps
 
@@ -137,6 +139,8 @@ def underlay_prefixes(env: dict[str, str], install_base: Path) -> list[str]:
 
 @functools.cache
 def _tool_identity(name: str, path: str | None) -> str | None:
+    import shutil  # here: it costs start-up (bz2, lzma), and a Python package's build has no tools
+
     found = shutil.which(name, path=path)
     if not found:
         return None

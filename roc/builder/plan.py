@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable
-from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
 from roc.builder.environment import ENVIRONMENT_FILE, build_environment
@@ -66,7 +65,7 @@ def plan_build(
     tasks = []
     for package in workspace.selected_in_order():
         dependencies = workspace.dependencies.in_order(package.name)
-        build = _PackageBuild(package, workspace.root, dependencies, options, jobserver, fingerprints)
+        build = _PackageBuild(package, dependencies, options, jobserver, fingerprints)
         build.remote, build.remote_keys, build.compiler = remote, remote_keys, compiler
         waits_for = {n for n in dependencies if n in selected}
         if proto_directory(build.source) is not None:
@@ -91,10 +90,10 @@ def plan_build(
 class _PackageBuild:
     """The up-to-date check and the action of one package's build task."""
 
-    def __init__(self, package: Package, root: Path, dependencies: list[str], options: BuildOptions,
-                 jobserver: Jobserver | None, fingerprints: Fingerprints):
+    def __init__(self, package: Package, dependencies: list[str], options: BuildOptions, jobserver: Jobserver | None,
+                 fingerprints: Fingerprints):
         self.package, self.dependencies, self.options = package, dependencies, options
-        self.source = (root / package.path).resolve()
+        self.source = fingerprints.source(package)
         self.prefix = package_prefix(options.install_base, package.name, options.merge_install)
         self.jobserver, self.fingerprints = jobserver, fingerprints
         self.state: PackageState | None = None

@@ -8,6 +8,7 @@ compute them all at once, in the same order.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 from roc.builder.environment import base_environment
 from roc.builder.fingerprint import (
@@ -62,6 +63,20 @@ class Fingerprints:
         self.prefixes = underlay_prefixes(self.environment, options.install_base)
         self._external: dict[str, str | None] = {}
         self._now: dict[str, str] = {}
+        self._sources: dict[str, Path] = {}
+        self._toolchains: dict[tuple[str, ...], dict[str, object]] = {}  # by the build type's tools
+
+    def source(self, package: Package) -> Path:
+        """The package's source directory, symbolic links resolved (once: a no-op build asks for
+        every package's)."""
+        if package.name not in self._sources:
+            self._sources[package.name] = (self.workspace.root / package.path).resolve()
+        return self._sources[package.name]
+
+    def _toolchain(self, tools: tuple[str, ...]) -> dict[str, object]:
+        if tools not in self._toolchains:
+            self._toolchains[tools] = toolchain_parts(self.environment, self.options.install_base, tools)
+        return self._toolchains[tools]
 
     def _fingerprint(self, name: str) -> str | None:
         if name in self._now:
@@ -77,13 +92,13 @@ class Fingerprints:
         """The package's state now; its dependencies must have been computed (or built) first."""
         by_name = self.workspace.by_name
         stored = read_state(self.options.build_base / package.name)
-        source = (self.workspace.root / package.path).resolve()
+        source = self.source(package)
         files = source_stamps(source, stored.get("files", {}))
         tools = build_tools(package.build_type, self.environment, self.options.cmake_args_for(package.name))
         parts = {
             "sources": source_parts(files),
             "options": _options_parts(package, self.options),
-            "toolchain": toolchain_parts(self.environment, self.options.install_base, tools),
+            "toolchain": self._toolchain(tools),
             "dependencies": {n: self._fingerprint(n)
                              for n in sorted(self.workspace.dependencies.recursive(package.name))},
             "underlay": {n: self._underlay(n) for n in sorted(package.direct_dependencies() - by_name.keys())},

@@ -8,19 +8,19 @@ byte-for-byte copies of source files with symlinks to them, so edits show withou
 
 from __future__ import annotations
 
-import configparser
-import hashlib
 import os
 import sys
-import sysconfig
 from pathlib import Path
 
 from roc.buildtypes.context import BuildOptions, PackageJob
 from roc.engine.process import TaskContext, TaskError
+from roc.fsutil import file_sha256
 
 
 def python_lib(prefix: Path) -> Path:
     """``<prefix>/lib/pythonX.Y/site-packages``."""
+    import sysconfig  # here: a no-op build does not need it
+
     return Path(sysconfig.get_path("purelib", "posix_prefix", vars={"base": str(prefix), "platbase": str(prefix)}))
 
 
@@ -29,6 +29,8 @@ def _install_scripts(source: Path, prefix: Path) -> str | None:
     setup_cfg = source / "setup.cfg"
     if not setup_cfg.is_file():
         return None
+    import configparser
+
     parser = configparser.ConfigParser(interpolation=None)
     parser.read(setup_cfg)
     value = parser.get("install", "install_scripts", fallback=None) or parser.get("install", "install-scripts",
@@ -71,10 +73,6 @@ def unlink_symlinks(record: Path) -> None:
                 Path(line).unlink()
 
 
-def _digest(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
-
-
 def link_to_sources(source: Path, record: Path) -> None:
     """Replace installed copies of source files (same name, same bytes) with symlinks to them."""
     by_name: dict[str, list[Path]] = {}
@@ -87,8 +85,8 @@ def link_to_sources(source: Path, record: Path) -> None:
         candidates = by_name.get(installed.name, [])
         if not candidates or installed.is_symlink() or not installed.is_file():
             continue
-        digest = _digest(installed)
-        matches = [c for c in candidates if _digest(c) == digest]
+        digest = file_sha256(installed)
+        matches = [c for c in candidates if file_sha256(c) == digest]
         if len(matches) == 1:
             temporary = installed.with_name(f".{installed.name}.roc-link")
             temporary.unlink(missing_ok=True)

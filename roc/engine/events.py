@@ -1,7 +1,9 @@
 """Events emitted while tasks run. Workers never print; handlers turn events into output and logs.
 
 Every task event names its task by ``kind`` (``build``, ``idl``, ``test``, ``probe``, ...) and ``task``
-(what it works on: a package, a probe); ``key`` joins them, as the engine does.
+(what it works on: a package, a probe); ``key`` joins them, as the engine does. Events are frozen and
+equal only to themselves (``eq=False``): a run compares none, and each method a dataclass generates
+costs every build's start-up.
 """
 
 from __future__ import annotations
@@ -10,7 +12,7 @@ import time
 from dataclasses import dataclass, field
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Event:
     task: str
     kind: str = "build"
@@ -26,41 +28,41 @@ def task_key(kind: str, name: str) -> str:
     return name if kind == "build" else f"{kind}:{name}"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TaskQueued(Event):
     pass
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TaskRestoring(Event):
     """A worker looks for the task's result in a cache (a remote build cache) before running it; a
     TaskFinished with ``restored`` or a TaskStarted (a miss, its reason among the reasons) follows."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TaskStarted(Event):
     reasons: tuple[str, ...] = ()  # why it is not up to date (empty when it has no up-to-date check)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CommandStarted(Event):
     command: tuple[str, ...] = ()
     cwd: str = ""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CommandEnded(Event):
     command: tuple[str, ...] = ()
     returncode: int = 0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TaskOutput(Event):
     stream: str = "stdout"  # or "stderr"
     data: bytes = b""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TaskFinished(Event):
     duration: float = 0.0
     cached: bool = False  # skipped because it was up to date
@@ -68,7 +70,7 @@ class TaskFinished(Event):
     worker: str = ""  # the cluster worker that ran it (roc work build --cluster); empty: it ran here
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TaskWarning(Event):
     """Something about a task the user should know that does not fail it (a remote cache that is down,
     a damaged cache entry)."""
@@ -76,27 +78,27 @@ class TaskWarning(Event):
     message: str = ""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TaskFailed(Event):
     duration: float = 0.0
     reason: str = ""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TaskAborted(Event):
     """Stopped while running, because another task failed or the user interrupted."""
 
     duration: float = 0.0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TaskSkipped(Event):
     """Never started because a dependency failed or was aborted."""
 
     because_of: str = ""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TestFailures(Event):
     """A test task's tests ran and some failed; the task itself still finishes, as in colcon (its
     result is "test failures", not a failure of the run)."""
@@ -104,7 +106,7 @@ class TestFailures(Event):
     __test__ = False
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TestsNotRun(Event):
     """A test task's tool ran no test (pytest collected none); the task still finishes, as in colcon.
     ``reason``: why, e.g. the test files that skipped themselves while pytest imported them."""
@@ -113,7 +115,7 @@ class TestsNotRun(Event):
     reason: str = ""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ProbeResult(Event):
     """A probe's verdict (``pass``, ``fail``, ``error``), sent before its task ends: what it found
     (``message``, ``measured``) and what was expected."""
@@ -124,7 +126,7 @@ class ProbeResult(Event):
     measured: object = field(default=None, hash=False)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class RunFinished(Event):
     """The whole run ended; ``task`` is empty."""
 
@@ -132,6 +134,6 @@ class RunFinished(Event):
     not_started: tuple[str, ...] = ()  # never started: the run stopped first
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Tick(Event):
     """Sent to handlers while the executor waits, so that a live status line can refresh."""

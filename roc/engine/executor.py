@@ -9,9 +9,7 @@ import queue
 import signal
 import threading
 import time
-import traceback
 from collections.abc import Callable, Iterable
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 from roc.engine.events import (
@@ -71,6 +69,8 @@ def _work(task: Task, context: TaskContext, reasons: tuple[str, ...]) -> None:
     except TaskError as error:
         context.emit(TaskFailed(task.name, task.kind, duration=time.monotonic() - start, reason=str(error)))
     except Exception:  # noqa: BLE001 - a bug in an action must fail its task, not hang the run
+        import traceback
+
         context.emit(TaskFailed(task.name, task.kind, duration=time.monotonic() - start,
                                 reason=traceback.format_exc()))
     else:
@@ -166,7 +166,9 @@ def execute(
     previous = {}
     if threading.current_thread() is threading.main_thread():
         previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
-    pool = ThreadPoolExecutor(max_workers=max(1, len(by_name)), thread_name_prefix="roc-worker")
+    # a thread per running task (at most limit() at once); no pool: concurrent.futures costs a no-op
+    # build's start-up more than its threads do
+    threads: list[threading.Thread] = []
     failure: BaseException | None = None
 
     def handle(event: Event) -> None:
@@ -202,7 +204,10 @@ def execute(
                     continue
                 context = TaskContext(task.name, events.put, task.kind)
                 context.priority = ready.priority(task.key)
-                pool.submit(_work, task, context, tuple(reasons or ()))
+                thread = threading.Thread(target=_work, args=(task, context, tuple(reasons or ())),
+                                          name=f"roc-worker-{task.key}")
+                thread.start()
+                threads.append(thread)
                 running[task.key] = context
             if not running:
                 break
@@ -212,7 +217,8 @@ def execute(
                 event = Tick("")
             handle(event)
     finally:
-        pool.shutdown(wait=True)
+        for thread in threads:
+            thread.join()
         while not events.empty():  # events emitted by the last workers while shutting down
             handle(events.get())
         for sig, handler in previous.items():
