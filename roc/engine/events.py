@@ -3,7 +3,8 @@
 Every task event names its task by ``kind`` (``build``, ``idl``, ``test``, ``probe``, ...) and ``task``
 (what it works on: a package, a probe); ``key`` joins them, as the engine does. Events are frozen and
 equal only to themselves (``eq=False``): a run compares none, and each method a dataclass generates
-costs every build's start-up.
+costs every build's start-up (so does a class without a docstring: dataclasses makes one from its
+signature).
 """
 
 from __future__ import annotations
@@ -14,9 +15,11 @@ from dataclasses import dataclass, field
 
 @dataclass(frozen=True, eq=False)
 class Event:
+    """Something that happened to task ``task`` of kind ``kind``, at ``time``."""
+
     task: str
     kind: str = "build"
-    time: float = field(default_factory=time.time, compare=False)
+    time: float = field(default_factory=time.time)
 
     @property
     def key(self) -> str:
@@ -30,7 +33,7 @@ def task_key(kind: str, name: str) -> str:
 
 @dataclass(frozen=True, eq=False)
 class TaskQueued(Event):
-    pass
+    """The task is known to the run; it starts once its dependencies are done."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,29 +44,39 @@ class TaskRestoring(Event):
 
 @dataclass(frozen=True, eq=False)
 class TaskStarted(Event):
+    """The task runs (its up-to-date check found ``reasons`` to)."""
+
     reasons: tuple[str, ...] = ()  # why it is not up to date (empty when it has no up-to-date check)
 
 
 @dataclass(frozen=True, eq=False)
 class CommandStarted(Event):
+    """The task started a command, in ``cwd``."""
+
     command: tuple[str, ...] = ()
     cwd: str = ""
 
 
 @dataclass(frozen=True, eq=False)
 class CommandEnded(Event):
+    """A command of the task ended with ``returncode``."""
+
     command: tuple[str, ...] = ()
     returncode: int = 0
 
 
 @dataclass(frozen=True, eq=False)
 class TaskOutput(Event):
+    """Output of the task's commands, as it came."""
+
     stream: str = "stdout"  # or "stderr"
     data: bytes = b""
 
 
 @dataclass(frozen=True, eq=False)
 class TaskFinished(Event):
+    """The task succeeded, or was up to date (``cached``), or was restored from a cache."""
+
     duration: float = 0.0
     cached: bool = False  # skipped because it was up to date
     restored: bool = False  # not run: its result was fetched from a cache (after a TaskRestoring)
@@ -80,6 +93,8 @@ class TaskWarning(Event):
 
 @dataclass(frozen=True, eq=False)
 class TaskFailed(Event):
+    """The task failed, for ``reason``."""
+
     duration: float = 0.0
     reason: str = ""
 
