@@ -149,8 +149,9 @@ def total_lost(counts: list[int | None]) -> int | None:
 
 def echo(graph, params: dict[str, Any]) -> Events:
     """Subscribe to ``params["topic"]`` and yield ``{"event": "messages", "messages": [{data, info,
-    lost}]}`` with what arrived since the last event (``lost``: messages the publisher's sequence
-    numbers say never arrived; None, unknown, where the middleware gives none: Cyclone DDS),
+    lost, publisher}]}`` with what arrived since the last event (``lost``: messages the publisher's
+    sequence numbers say never arrived; None, unknown, where the middleware gives none: Cyclone DDS;
+    ``publisher``: its gid, as roc.ros.raw_subscription.gid_text),
     ``{"event": "subscribed", "type"}`` first and heartbeats in between.
     Params: ``topic``, ``wait`` (seconds to wait for a publisher to be discovered), ``type`` (else the
     graph's), ``qos`` (see qos_profile), ``timeout`` (seconds for the first message, counted from the
@@ -182,9 +183,9 @@ def echo(graph, params: dict[str, Any]) -> Events:
             return [item for item in batch if local.accepts(deserialize_message(item[1], cls))] if local else batch
 
         def lost(info: dict[str, Any]) -> int | None:
-            """The messages of info's publisher that never arrived since its last one (info loses its gid);
-            None, unknown, where the middleware gives no sequence numbers (Cyclone DDS)."""
-            sequence, gid = info["publication_sequence_number"], info.pop("gid")
+            """The messages of info's publisher that never arrived since its last one; None, unknown,
+            where the middleware gives no sequence numbers (Cyclone DDS)."""
+            sequence, gid = info["publication_sequence_number"], info["gid"]
             if wanted is not None:
                 return 0  # the messages filtered out are not lost
             if sequence is None:
@@ -209,8 +210,9 @@ def echo(graph, params: dict[str, Any]) -> Events:
                 carried = total_lost([carried, *(lost(info) for _, _, info in batch[:-1])])
                 batch, sent = batch[-1:], time.monotonic()
             messages: list[dict[str, Any]] = [
-                {"data": base64.b64encode(data).decode(), "lost": lost(info),
-                 "info": {key: value for key, value in info.items() if value is not None}} for _, data, info in batch]
+                {"data": base64.b64encode(data).decode(), "lost": lost(info), "publisher": info["gid"],
+                 "info": {key: value for key, value in info.items() if value is not None and key != "gid"}}
+                for _, data, info in batch]
             messages[0]["lost"] = total_lost([messages[0]["lost"], carried])
             if params.get("latest_value"):
                 messages[-1]["value"] = value_to_data(deserialize_message(batch[-1][1], cls),
@@ -291,18 +293,20 @@ def header_stamp_ns(data: bytes) -> int | None:
 def stats(graph, params: dict[str, Any]) -> Events:
     """Subscribe to each of ``params["topics"]`` and yield, every ``period`` seconds, a ``batch`` of
     what arrived: per topic, lists of publication sequence numbers, source and reception timestamps
-    (ns), serialised sizes and, with ``stamps``, header stamps (ns) — never deserialising a message,
-    so that a fast topic does not outrun the subscriber. ``subscribed {topic, type}`` (or
-    ``not_published {topic}``, then heartbeats until the topic appears) first, per topic.
+    (ns), serialised sizes, publishers (a number per publisher gid, counted from 0 in each stream: a
+    rate is the sum of the publishers', roc.ros.rates) and, with ``stamps``, header stamps (ns) — never
+    deserialising a message, so that a fast topic does not outrun the subscriber. ``subscribed {topic,
+    type}`` (or ``not_published {topic}``, then heartbeats until the topic appears) first, per topic.
     Volatile unless ``qos`` says otherwise: a measure counts what is published from now on, and a
     transient local publisher's history (Fast DDS's writers are transient local by default, depth 1)
     would come first, late, and count as a delay of up to a period (``topic delay``) or bytes
     received at once (``topic bw``)."""
     period, stamps = params.get("period", 1.0), params.get("stamps")
     qos = {**(params.get("qos") or {}), "durability": (params.get("qos") or {}).get("durability") or "volatile"}
-    columns = ("sequence", "source", "received", "size", "stamp")
+    columns = ("sequence", "source", "received", "size", "stamp", "publisher")
     receiver = Receiver(graph.node)
     local: dict[Hashable, tuple[ContentFilter, Any]] = {}  # filtered here, with the topic's class
+    numbers: dict[str, int] = {}  # publisher gid -> its number in the ``publisher`` column
     try:
         for topic in params["topics"]:
             cls, type_name, found = yield from _topic_class(graph, topic, params, wait_for_type=True)
@@ -328,6 +332,7 @@ def stats(graph, params: dict[str, Any]) -> Events:
                     columns_of_topic["received"].append(info["received_timestamp"])
                     columns_of_topic["size"].append(len(data))
                     columns_of_topic["stamp"].append(header_stamp_ns(data) if stamps else None)
+                    columns_of_topic["publisher"].append(numbers.setdefault(info["gid"], len(numbers)))
             yield {"event": "batch", "topics": arrived}
     finally:
         receiver.close()

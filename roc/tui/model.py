@@ -111,15 +111,16 @@ def bandwidth_text(bytes_per_second: float | None) -> str:
 
 
 class Rates:
-    """The rate and bandwidth of each topic, from the ``stats`` stream's batches (as roc topic hz and
-    bw measure them: roc.ros.rates).
+    """The rate and bandwidth of each topic, from the ``stats`` stream's batches, as roc topic hz and
+    bw measure them (roc.ros.rates): the sum of each publisher's, so that a topic with several
+    publishers reads right from the second message of each (in a stream's first 2 s, nothing before
+    that: roc.ros.rates.PENDING_SECONDS).
 
     Each stream (``restart``: the first screen asks for a new one whenever the published topics change)
-    fills windows of its own: a window holding the messages of two streams spans the time between them,
-    when no message was received, and a topic with several publishers (its messages counted, having no
-    one sequence) read low for as long as the old messages stayed in it (1.8 Hz for 2.1 after a few
-    restarts, lower under load, where restarts are slower). The last stream's windows are shown until the
-    new ones can measure."""
+    fills windows of its own: each stream numbers the publishers of its ``publisher`` column from 0, and
+    a window holding the messages of two streams would span the time between them, when no message was
+    received (counted messages read low: 0.7 Hz for 2.1 after some restarts under load). The last
+    stream's windows are shown until the new ones have measured for SETTLED seconds."""
 
     def __init__(self, size: int = LIST_WINDOW):
         self.size = size
@@ -149,11 +150,13 @@ class Rates:
 
     def _window(self, topic: str, measure) -> Any:
         """``measure`` of the topic's window, or of the last stream's until the new one spans SETTLED
-        seconds (its first two messages can come from two publishers a moment apart: 500 Hz)."""
+        seconds and measures (a rate over a few messages is less steady than the last stream's)."""
         window, before = self.windows.get(topic), self.before.get(topic)
         if window and len(window.samples) > 1 and (
                 before is None or (window.samples[-1].received - window.samples[0].received) * 1e-9 >= SETTLED):
-            return measure(window)
+            measured = measure(window)
+            if measured is not None or before is None:
+                return measured
         return measure(before) if before else None
 
     def rate(self, topic: str) -> float | None:

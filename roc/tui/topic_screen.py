@@ -149,7 +149,8 @@ class TopicScreen(Screen):
         for message in messages:
             info = message["info"]
             self.window.add([Sample(info.get("publication_sequence_number"), info.get("source_timestamp"),
-                                    info.get("received_timestamp") or time.time_ns(), cdr_size(message["data"]), None)])
+                                    info.get("received_timestamp") or time.time_ns(), cdr_size(message["data"]), None,
+                                    message.get("publisher"))])
         self.count += len(messages)
         self.latest = messages[-1]
 

@@ -94,3 +94,80 @@ def test_header_stamp_is_read_from_cdr() -> None:
     header.stamp.sec, header.stamp.nanosec = 12, 345
     assert header_stamp_ns(serialize_message(header)) == 12_000_000_345
     assert header_stamp_ns(b"\x00\x01") is None
+
+
+def _columns(messages: list[tuple[str, int, float]], size: int = 10) -> dict[str, list]:
+    """A ``stats`` batch's columns of (publisher, sequence, source ms) messages, received as sent."""
+    return {"sequence": [m[1] for m in messages], "source": [int(m[2] * MS) for m in messages],
+            "received": [int(m[2] * MS) for m in messages], "size": [size] * len(messages),
+            "stamp": [None] * len(messages), "publisher": [m[0] for m in messages]}
+
+
+def _arriving(window: Window, messages: list[tuple[str, int, float]]):
+    """Add ``messages`` to ``window`` in time order, one at a time, yielding each after it is added."""
+    for message in sorted(messages, key=lambda m: m[2]):
+        window.add(samples(_columns([message])))
+        yield message
+
+
+def test_several_publishers_read_their_sum_from_the_second_message_of_each() -> None:
+    """Issue 51: a 1 Hz and a 2 Hz publisher, the second starting 0.3 s after the first, are 3 Hz as soon
+    as each was heard twice (counted over their span, the messages read 3.07, 2.86, 3.11 Hz...)."""
+    one = [("a", 10 + n, n * 1000.0) for n in range(6)]
+    two = [("b", 500 + n, 300 + n * 500.0) for n in range(10)]
+    window, heard, rates = Window(10000), {"a": 0, "b": 0}, []
+    for publisher, _, _ in _arriving(window, one + two):
+        heard[publisher] += 1
+        if min(heard.values()) >= 2:
+            rates.append(window.frequency())
+            assert window.rate()["rate"] == pytest.approx(3.0)
+            assert window.bandwidth()["bytes_per_second"] == pytest.approx(30.0)  # 10-byte messages
+        else:
+            assert window.frequency() is None  # one was heard once: unknown, not 1 or 2 Hz, in the first 2 s
+    assert rates == [pytest.approx(3.0)] * len(rates) and len(rates) == 13  # a's second message on
+    assert window.lost == 0
+    rate = window.rate()  # the statistics are the topic's: intervals between its consecutive messages
+    assert (rate["min"], rate["max"], rate["window"]) == (pytest.approx(0.2), pytest.approx(0.5), 16)
+
+
+def test_losses_are_counted_per_publisher() -> None:
+    window = Window(100)
+    window.add(samples(_columns([("a", 1, 0), ("b", 900, 10), ("a", 2, 100), ("b", 901, 110), ("a", 4, 300),
+                                 ("a", 5, 400), ("b", 904, 410)])))
+    assert (window.lost, window.known_lost()) == (3, 3)  # a's 3 and b's 902 and 903
+    assert window.frequency() == pytest.approx(20.0)  # each publishes at 10 Hz, the lost messages included
+
+
+def test_a_publisher_heard_once_counts_from_its_second_message() -> None:
+    window = Window(100)
+    window.add(samples(_columns([("a", n, n * 1000.0) for n in range(4)])))  # 1 Hz for 3 s
+    assert window.frequency() == pytest.approx(1.0)
+    window.add(samples(_columns([("b", 7, 3100)])))  # a new publisher, heard once: it adds nothing yet
+    assert window.frequency() == pytest.approx(1.0)
+    window.add(samples(_columns([("b", 8, 3600)])))
+    assert window.frequency() == pytest.approx(3.0)
+    young = Window(100)  # in a measure's first seconds, one heard once makes the rate unknown, not low
+    young.add(samples(_columns([("a", 1, 0), ("b", 1, 400), ("a", 2, 1000)])))
+    assert young.frequency() is None and young.rate() is None and young.bandwidth() is None
+    young.add(samples(_columns([("a", 3, 2000), ("a", 4, 3000)])))  # b said one thing only: a's rate
+    assert young.frequency() == pytest.approx(1.0)
+
+
+def test_a_stopped_publisher_counts_no_more() -> None:
+    window = Window(10000)
+    window.add(samples(_columns([("a", n, n * 500.0) for n in range(7)] + [("b", n, 250 + n * 500.0)
+                                                                         for n in range(7)])))
+    assert window.frequency() == pytest.approx(4.0)
+    window.add(samples(_columns([("a", n, n * 500.0) for n in range(7, 10)])))  # b stopped at 3.25 s
+    assert window.frequency() == pytest.approx(4.0)  # silent for 1.25 s: maybe late
+    window.add(samples(_columns([("a", n, n * 500.0) for n in range(10, 40)])))
+    assert window.frequency() == pytest.approx(2.0)  # silent for three of its intervals and more: stopped
+    assert window.rate()["window"] == 47  # its messages stay in the window's statistics
+
+
+def test_a_slow_publisher_beside_fast_ones_counts_from_its_last_two_messages() -> None:
+    window = Window(50)  # half a second of the 100 Hz publisher: one message of the 1 Hz one at most
+    fast = [("fast", n, n * 10.0) for n in range(400)]
+    slow = [("slow", n, 5 + n * 1000.0) for n in range(4)]
+    window.add(samples(_columns(sorted(fast + slow, key=lambda m: m[2]))))
+    assert window.frequency() == pytest.approx(101.0)

@@ -193,3 +193,21 @@ def test_a_rate_measured_again_after_a_gap_in_its_stream_is_not_low() -> None:
     assert abs(rates.rate("/y") - 2.1) < 0.25  # not 3.3 Hz: the two publishers' first messages, 0.3 s apart
     rates.add({"topics": {"/y": {name: values[2:] for name, values in columns.items()}}})
     assert abs(rates.rate("/y") - 2.1) < 0.25, rates.rate("/y")  # was 1.05: 8 s of messages over 14 s
+
+
+def test_a_new_stream_that_cannot_measure_yet_leaves_the_last_streams_rate() -> None:
+    """Two publishers at 0.4 Hz: 2.5 s into a new stream, each was heard once (no rate of its own yet);
+    the list keeps the last stream's 0.8 Hz rather than showing none."""
+    from roc.tui.model import Rates
+
+    def batch(messages: list[tuple[int, int, float]]) -> dict:
+        return {"topics": {"/slow": {"sequence": [m[1] for m in messages], "source": [int(m[2] * 1e9) for m in messages],
+                                     "received": [int(m[2] * 1e9) for m in messages], "size": [10] * len(messages),
+                                     "stamp": [None] * len(messages), "publisher": [m[0] for m in messages]}}}
+
+    rates = Rates()
+    rates.add(batch([(p, n, p + n * 2.5) for n in range(4) for p in (0, 1)]))
+    assert rates.rate("/slow") == pytest.approx(0.8)
+    rates.restart()
+    rates.add(batch([(0, 9, 20.0), (1, 9, 22.5)]))
+    assert rates.rate("/slow") == pytest.approx(0.8)

@@ -77,13 +77,13 @@ def print_lines_of(lines: list[str]) -> None:
 
 def _filtered(args: argparse.Namespace, topic: str, accept, wait: float, content_filter: dict | None):
     """``batch`` events from the ``echo`` stream, with only the messages ``accept`` takes. Without their
-    sequence numbers: the messages left out are not lost, and the rate is of those that pass (counted
-    over their source timestamps), not the publisher's."""
+    sequence numbers: the messages left out are not lost, and the rate is of those that pass (each
+    publisher's counted over their source timestamps), not the publishers'."""
     import base64
 
     from roc.ros.cdr import decode
 
-    columns = ("sequence", "source", "received", "size", "stamp")
+    columns = ("sequence", "source", "received", "size", "stamp", "publisher")
     batch: dict[str, list] = {column: [] for column in columns}
     type_name, due = "", time.monotonic() + 1.0
     for event in stream("echo", {"topic": topic, "wait": wait, "content_filter": content_filter},
@@ -99,7 +99,8 @@ def _filtered(args: argparse.Namespace, topic: str, accept, wait: float, content
                     info = message["info"]
                     for column, value in zip(columns, (
                             None, info.get("source_timestamp"),
-                            info.get("received_timestamp"), len(base64.b64decode(message["data"])), None)):
+                            info.get("received_timestamp"), len(base64.b64decode(message["data"])), None,
+                            message.get("publisher"))):
                         batch[column].append(value)
         if time.monotonic() >= due:
             yield {"event": "batch", "topics": {topic: batch}}
