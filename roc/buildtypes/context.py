@@ -58,6 +58,9 @@ class BuildOptions:
 
 @dataclass
 class PackageJob:
+    """One package's build as a build type runs it: where its source, build directory and install
+    prefix are, and the environment, jobserver and CMake arguments roc gives it."""
+
     package: Package
     source: Path  # absolute package directory
     build_dir: Path

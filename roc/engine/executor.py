@@ -34,6 +34,8 @@ TICK_SECONDS = 0.25
 
 @dataclass
 class RunResult:
+    """What became of each task of a run."""
+
     finished: list[str] = field(default_factory=list)
     failed: list[str] = field(default_factory=list)
     aborted: list[str] = field(default_factory=list)

@@ -31,6 +31,8 @@ SYSTEM_LIBRARY_FOLDERS = ("/lib", "/usr/lib", "/lib64", "/usr/lib64", "/usr/loca
 
 @dataclass(frozen=True)
 class Underlay:
+    """A prefix of the environment chain and how its environment is made."""
+
     prefix: str
     # empty: the prefix has local_setup scripts to source; else its packages' hooks, to apply
     operations: tuple[Operation, ...] = ()

@@ -20,6 +20,8 @@ SET_TYPES = ("set", "set-if-unset")
 
 @dataclass(frozen=True)
 class Operation:
+    """One environment change of a prefix or a package's hook (a dsv line, or a script to source)."""
+
     kind: str  # one of the types above, or "source" (a script without a .dsv twin, for the shell of its suffix)
     name: str  # variable name, or the script path for "source"
     values: tuple[str, ...] = ()  # paths relative to the prefix (absolute ones stay absolute)
