@@ -14,7 +14,6 @@ the worker's path), and when a dependency was built here for one of these reason
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from roc.builder.state import read_state
@@ -51,7 +50,7 @@ class ClusterBuilds:
         cluster = self.cluster.get()
         result = cluster.run(on_worker.build, self._work(build, cluster), f"roc-build-{build.remote_key}", context)
         for event in result.events:
-            context.emit(replace(event, task=context.name, kind=context.kind))
+            context.emit(event.for_task(context.name, context.kind))
         if not result.ok:
             raise TaskError(result.reason)
         if result.bound:

@@ -13,7 +13,6 @@ from __future__ import annotations
 import shutil
 import tempfile
 import uuid
-from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -52,7 +51,7 @@ class ClusterTests:
         work = self._work(test, keys)
         result = self.cluster.run(on_worker.test, work, f"roc-test-{work.key}-{uuid.uuid4().hex[:8]}", context)
         for event in result.events:
-            context.emit(replace(event, task=context.name, kind=context.kind))
+            context.emit(event.for_task(context.name, context.kind))
         if not result.ok or result.results is None:
             raise TaskError(result.reason or "no test results")
         self._fetch_results(result.results, test.options.result_dir(test.package.name))
