@@ -9,7 +9,6 @@ local_setup scripts), then those a colcon.pkg names.
 from __future__ import annotations
 
 import os
-import subprocess
 from functools import lru_cache
 from pathlib import Path
 
@@ -43,6 +42,7 @@ def multiarch() -> str | None:
     """The multiarch triplet (e.g. x86_64-linux-gnu) that colcon-ros uses for pkg-config paths: Python's
     own (Debian's and most builds know it), else gcc's (a package restored from a cache is finished
     without running a compiler)."""
+    import subprocess
     import sysconfig
 
     known = sysconfig.get_config_var("MULTIARCH")

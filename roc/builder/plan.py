@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Protocol
 
 from roc.builder.environment import ENVIRONMENT_FILE, build_environment
 from roc.builder.finish import finish_package
@@ -32,16 +31,18 @@ from roc.idl.task import cmake_arguments as idl_cmake_arguments
 from roc.workspace.load import Workspace
 from roc.workspace.package import Package
 
+TYPE_CHECKING = False  # typing is not imported at run time (start-up time of every build)
 if TYPE_CHECKING:
+    from typing import Protocol
+
     from roc.builder.compiler_cache import CompilerCache
     from roc.remote_cache.cache import RemoteCache
     from roc.remote_cache.keys import RemoteKeys
 
+    class RemoteBuilds(Protocol):
+        """Where packages are built instead of here (roc.cluster.remote_build.ClusterBuilds)."""
 
-class RemoteBuilds(Protocol):
-    """Where packages are built instead of here (roc.cluster.remote_build.ClusterBuilds)."""
-
-    def action(self, build: _PackageBuild) -> Callable[[TaskContext], object]: ...
+        def action(self, build: _PackageBuild) -> Callable[[TaskContext], object]: ...
 
 
 def plan_build(

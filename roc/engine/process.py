@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import os
-import selectors
-import subprocess
 import threading
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 from roc.engine.events import CommandEnded, CommandStarted, Event, TaskOutput
+
+TYPE_CHECKING = False  # subprocess and selectors are imported where a command runs: a no-op build runs none
+if TYPE_CHECKING:
+    import subprocess
 
 STOP_GRACE_SECONDS = 3.0
 
@@ -85,6 +87,8 @@ class TaskContext:
         pass_fds: Sequence[int] = (),
     ) -> int:
         """Run ``command``, emitting its output; returns the exit code, raises TaskCancelled if cancelled."""
+        import subprocess
+
         command = tuple(str(part) for part in command)
         with self._lock:
             if self.cancelled:
@@ -109,6 +113,8 @@ class TaskContext:
         return returncode
 
     def _pump(self, process: subprocess.Popen) -> None:
+        import selectors
+
         assert process.stdout is not None and process.stderr is not None  # started with PIPE for both
         with selectors.DefaultSelector() as selector:
             selector.register(process.stdout, selectors.EVENT_READ, "stdout")

@@ -5,7 +5,6 @@ from __future__ import annotations
 import sys
 import time
 from collections.abc import Collection
-from typing import TextIO
 
 from roc.engine.events import (
     Event,
@@ -22,6 +21,10 @@ from roc.engine.events import (
 )
 from roc.handlers.logs import task_log_folder
 from roc.render import plural
+
+TYPE_CHECKING = False  # typing is not imported at run time (start-up time of every build)
+if TYPE_CHECKING:
+    from typing import TextIO
 
 
 def format_duration(seconds: float) -> str:

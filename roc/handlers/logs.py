@@ -11,7 +11,6 @@ import os
 import shlex
 import time
 from pathlib import Path
-from typing import BinaryIO
 
 from roc.engine.events import (
     CommandEnded,
@@ -27,6 +26,10 @@ from roc.engine.events import (
 )
 from roc.fsutil import write_text_atomic, write_text_if_changed
 from roc.workspace.selection import INTERRUPTED_RESULT
+
+TYPE_CHECKING = False  # typing is not imported at run time (start-up time of every build)
+if TYPE_CHECKING:
+    from typing import BinaryIO
 
 
 def event_json(event: Event) -> str:
