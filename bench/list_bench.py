@@ -41,7 +41,8 @@ sys.path.insert(0, str(HERE))
 
 from gen_workspace import ensure  # noqa: E402
 
-TARGET = 10.0
+# roc's speed over colcon's: 60x at 1000 packages from the discovery cache (issue 51), 10x without it
+TARGETS = {"plain": 60.0, "boot": 60.0, "cold": 10.0}
 BOOT_FLAG = "_ROS_WHEELS_BOOTSTRAP_COMPLETE"
 
 
@@ -188,9 +189,10 @@ def main(argv: list[str] | None = None) -> int:
           f"{os.cpu_count()} CPUs{note}")
     for variant in args.variants:
         mine = [row for row in rows if row[1] == variant]
-        met = all(row[6] >= TARGET for row in mine)
+        target = TARGETS[variant]
+        met = all(row[6] >= target for row in mine)
         detail = ", ".join(f"{row[6]:.1f}x at {row[0]} (CPU {row[9]:.1f}x)" for row in mine)
-        print(f"verdict ({variant}): target roc >= {TARGET:.0f}x faster at every size: "
+        print(f"verdict ({variant}): target roc >= {target:.0f}x faster at every size: "
               f"{'MET' if met else 'MISSED'} ({detail})")
     return 0
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from roc.errors import RocError, UsageError
@@ -79,11 +80,22 @@ def prepare_install_base(install_base: Path, merged: bool) -> None:
 
 def installed_in_order(install_base: Path, merged: bool) -> list[str]:
     """Packages installed in the base (built by roc or colcon) in the order colcon's setup scripts use."""
-    pattern = "share/colcon-core/packages/*" if merged else "*/share/colcon-core/packages/*"
+    base = str(install_base)
+    try:
+        prefixes = [base] if merged else [os.path.join(base, name) for name in sorted(os.listdir(base))]
+    except OSError:  # no install base yet
+        prefixes = []
     run_dependencies = {}
-    for marker in install_base.glob(pattern):
-        text = marker.read_text().strip()
-        run_dependencies[marker.name] = set(text.split(":")) if text else set()
+    for prefix in prefixes:  # os, not pathlib's glob: a no-op build of 100 packages spent 5 ms there
+        folder = os.path.join(prefix, "share", "colcon-core", "packages")
+        try:
+            names = sorted(os.listdir(folder))
+        except OSError:  # not a package's prefix (a file, COLCON_IGNORE) or one without markers
+            continue
+        for name in names:
+            with open(os.path.join(folder, name)) as marker:
+                text = marker.read().strip()
+            run_dependencies[name] = set(text.split(":")) if text else set()
     return layered_order(run_dependencies, one_at_a_time=True)
 
 
