@@ -7,7 +7,7 @@ compute them all at once, in the same order.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections import namedtuple
 from pathlib import Path
 
 from roc.builder.environment import base_environment
@@ -29,10 +29,10 @@ from roc.workspace.load import Workspace
 from roc.workspace.package import Package
 
 
-@dataclass
-class PackageState:
+class PackageState(namedtuple("PackageState", ("fingerprint", "parts", "files", "stored"))):
     """One package now (fingerprint, its parts, the file stamps to store) and at its last build."""
 
+    __slots__ = ()
     fingerprint: str
     parts: dict
     files: dict

@@ -30,9 +30,10 @@ def finish(code: int) -> NoReturn:
     import atexit
 
     threading = sys.modules.get("threading")  # never imported: no thread but this one
-    for thread in threading.enumerate() if threading else ():
-        if thread is not threading.main_thread() and not thread.daemon:
-            thread.join()
+    if threading is not None:
+        for thread in threading.enumerate():
+            if thread is not threading.main_thread() and not thread.daemon:
+                thread.join()
     atexit._run_exitfuncs()  # CPython's own step of its exit: the callbacks registered with atexit
     for stream in (sys.stdout, sys.stderr):
         try:

@@ -10,7 +10,6 @@ import signal
 import threading
 import time
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
 
 from roc.engine.events import (
     Event,
@@ -32,16 +31,16 @@ Handler = Callable[[Event], None]
 TICK_SECONDS = 0.25
 
 
-@dataclass
 class RunResult:
     """What became of each task of a run."""
 
-    finished: list[str] = field(default_factory=list)
-    failed: list[str] = field(default_factory=list)
-    aborted: list[str] = field(default_factory=list)
-    skipped: dict[str, str] = field(default_factory=dict)  # task -> the failed task that caused it
-    not_started: list[str] = field(default_factory=list)
-    interrupted: bool = False
+    def __init__(self) -> None:
+        self.finished: list[str] = []
+        self.failed: list[str] = []
+        self.aborted: list[str] = []
+        self.skipped: dict[str, str] = {}  # task -> the failed task that caused it
+        self.not_started: list[str] = []
+        self.interrupted = False
 
     @property
     def ok(self) -> bool:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import os
 import threading
+from collections import namedtuple
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
 
 from roc.engine.events import CommandEnded, CommandStarted, Event, TaskOutput
 
@@ -24,11 +24,11 @@ class TaskCancelled(Exception):
     """The task was stopped from outside (another task failed, or Ctrl+C)."""
 
 
-@dataclass(frozen=True)
-class RanElsewhere:
+class RanElsewhere(namedtuple("RanElsewhere", ("worker", "duration"))):
     """What an action returns when another machine did its work (a cluster worker): the worker's name
     and how long the work took there, which its TaskFinished event carries instead of the time here."""
 
+    __slots__ = ()
     worker: str
     duration: float
 

@@ -15,8 +15,8 @@ import contextlib
 import hashlib
 import json
 import os
+from collections import namedtuple
 from collections.abc import Mapping
-from dataclasses import dataclass
 from pathlib import Path
 
 from roc.environment import AMENT_INDEX, path_list
@@ -29,13 +29,14 @@ CACHE_VERSION = 2  # of prefix_operations' cache: 2 added wheel_library_operatio
 SYSTEM_LIBRARY_FOLDERS = ("/lib", "/usr/lib", "/lib64", "/usr/lib64", "/usr/local/lib")
 
 
-@dataclass(frozen=True)
-class Underlay:
-    """A prefix of the environment chain and how its environment is made."""
+class Underlay(namedtuple("Underlay", ("prefix", "operations"), defaults=((),))):
+    """A prefix of the environment chain and how its environment is made (a named tuple, as
+    roc.environment.dsv.Operation)."""
 
+    __slots__ = ()
     prefix: str
-    # empty: the prefix has local_setup scripts to source; else its packages' hooks, to apply
-    operations: tuple[Operation, ...] = ()
+    # empty (the default): the prefix has local_setup scripts to source; else its packages' hooks, to apply
+    operations: tuple[Operation, ...]
 
 
 def _has_local_setup(prefix: Path) -> bool:
