@@ -1,4 +1,4 @@
-"""How tasks run: a pool of worker threads fed by the ReadyQueue; events go to handlers.
+"""How tasks run: a worker thread per running task, fed by the ReadyQueue; events go to handlers.
 
 Handlers are called from the calling thread only, in event order, so they need no locking.
 """
