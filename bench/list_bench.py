@@ -41,8 +41,10 @@ sys.path.insert(0, str(HERE))
 
 from gen_workspace import ensure  # noqa: E402
 
-# roc's speed over colcon's: 60x at 1000 packages from the discovery cache (issue 51), 10x without it
+# roc's speed over colcon's at TARGET_SIZE packages or more: 60x from the discovery cache (issue 51), 10x
+# without it (smaller workspaces are shown, not judged: colcon's own start-up dominates there)
 TARGETS = {"plain": 60.0, "boot": 60.0, "cold": 10.0}
+TARGET_SIZE = 1000
 BOOT_FLAG = "_ROS_WHEELS_BOOTSTRAP_COMPLETE"
 
 
@@ -188,11 +190,14 @@ def main(argv: list[str] | None = None) -> int:
     print(f"load average (1 min): {load_before:.2f} before, {load_after:.2f} after, "
           f"{os.cpu_count()} CPUs{note}")
     for variant in args.variants:
-        mine = [row for row in rows if row[1] == variant]
+        mine = [row for row in rows if row[1] == variant and row[0] >= TARGET_SIZE]
         target = TARGETS[variant]
+        if not mine:
+            print(f"verdict ({variant}): not judged (the target is for {TARGET_SIZE} packages or more)")
+            continue
         met = all(row[6] >= target for row in mine)
         detail = ", ".join(f"{row[6]:.1f}x at {row[0]} (CPU {row[9]:.1f}x)" for row in mine)
-        print(f"verdict ({variant}): target roc >= {target:.0f}x faster at every size: "
+        print(f"verdict ({variant}): target roc >= {target:.0f}x faster from {TARGET_SIZE} packages: "
               f"{'MET' if met else 'MISSED'} ({detail})")
     return 0
 
