@@ -1,6 +1,7 @@
 """The one RTPS message roc writes itself: a participant announcement (SPDP DATA(p), RTPS 2.3 8.5.3 and
-9.6.2) of a short-lived stand-in participant that names roc's own participant's discovery port; and the
-one thing roc reads of the announcements that answer it, their properties (``announced_properties``).
+9.6.2) of a short-lived stand-in participant that names roc's own participant's discovery port; what roc
+reads of the announcements that answer it, their properties (``announced_properties``); and such an
+answer made fit for roc's own participant (``undirected``).
 
 Why: a Fast DDS participant (2.14 and 3.x alike) sends its first announcement before it listens
 (RTPSParticipantImpl::enable), so the announcements other participants send back at once to the newcomer
@@ -40,6 +41,8 @@ PID_BUILTIN_ENDPOINT_SET = 0x0058
 PID_PROPERTY_LIST = 0x0059
 FLAG_LITTLE_ENDIAN, FLAG_INLINE_QOS = 0x01, 0x02
 PARTICIPANT_ANNOUNCER_AND_DETECTOR = 0x3  # the only builtin endpoints the stand-in has
+SUBMESSAGE_INFO_DST = 0x0E  # what follows in the message is for the participant it names only (RTPS 8.3.7.7)
+ZERO_LENGTH_SUBMESSAGES = (0x01, 0x09)  # PAD and INFO_TS: a length of 0 is theirs; any other's runs to the end
 LEASE_SECONDS = 1
 
 
@@ -133,3 +136,30 @@ def _string(message: bytes, offset: int, order: str) -> tuple[str, int]:
     (length,) = struct.unpack_from(order + "I", message, offset)
     text = message[offset + 4:offset + 4 + length].rstrip(b"\0").decode()
     return text, offset + 4 + length + (-length % 4)
+
+
+def undirected(message: bytes) -> bytes | None:
+    """The RTPS message ``message`` without its INFO_DST submessages, None when it has none (or is no RTPS
+    message). Why: Cyclone DDS answers a participant new to it with an announcement directed to that
+    participant (INFO_DST naming its GUID prefix), which any other participant ignores, and it answers
+    only participants new to it. So the answer to a fresh Fast DDS participant's first announcement, lost
+    while that participant did not listen yet (above), is not made good by the answer to the stand-in,
+    which names the stand-in: the participant would hear Cyclone only at Cyclone's next directed
+    announcement, 1 s later. That answer undirected is one it takes (roc.ros.discovery.LocalParticipantProbe
+    passes it on)."""
+    if not message.startswith(b"RTPS"):
+        return None
+    kept, offset, directed = [message[:20]], 20, False
+    try:
+        while offset + 4 <= len(message):
+            kind, flags = message[offset], message[offset + 1]
+            (length,) = struct.unpack_from("<H" if flags & FLAG_LITTLE_ENDIAN else ">H", message, offset + 2)
+            end = len(message) if length == 0 and kind not in ZERO_LENGTH_SUBMESSAGES else offset + 4 + length
+            if kind == SUBMESSAGE_INFO_DST:
+                directed = True
+            else:
+                kept.append(message[offset:end])
+            offset = end
+    except struct.error:
+        return None
+    return b"".join(kept) if directed else None

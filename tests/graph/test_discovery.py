@@ -7,6 +7,7 @@ queries on the suite's middleware and in a domain where Fast DDS and Cyclone DDS
 from __future__ import annotations
 
 import json
+import os
 import socket
 import struct
 import subprocess
@@ -33,7 +34,7 @@ from roc.ros.discovery import (
     metatraffic_sockets,
     own_socket_inodes,
 )
-from roc.ros.spdp import SPDP_WRITER, stand_in_announcement
+from roc.ros.spdp import SPDP_WRITER, stand_in_announcement, undirected
 from roc.ros.vendors.fastdds import process_bits
 
 SLOT = 67
@@ -116,6 +117,24 @@ def test_a_participant_is_wholly_known_once_its_message_has_come_and_all_it_list
     assert incomplete_participants(writers, {}, set(), set()) == 3
 
 
+def test_a_participant_of_roc_s_own_nodes_only_is_complete_once_its_message_has_come() -> None:
+    """roc's daemon on Cyclone DDS: rmw_cyclonedds 2.2.2 leaves a destroyed subscription listed in its
+    participant's message (ros2/rmw_cyclonedds#594), so the reader of the daemon's first wait stays told
+    and is never discovered. roc leaves its own nodes out of every answer: such a participant is not
+    waited for once its message has come; any other participant's told reader still is."""
+    daemon, listener = "0110" "3333bbbb" "44444444" "0000", FAST_DDS_PREFIX
+    writers = [Writer(prefix) for prefix in (daemon, listener)]
+    gone, listener_sub = daemon + "00000704", listener + "00000104"
+    told = {bytes.fromhex(daemon): _told(["_roc_7"], [gone]), bytes.fromhex(listener): _told(["listener"], [listener_sub])}
+    nodes = {("/", "_roc_7"), ("/", "listener")}
+    assert incomplete_participants(writers, told, {bytes.fromhex(listener_sub)}, nodes) == 0
+    assert incomplete_participants(writers, told, set(), nodes) == 1  # the listener's reader is waited for
+    assert incomplete_participants(writers, {}, set(), set()) == 2  # no message yet: whose it is is not known
+    # a roc bridge's node is no node of roc's own: its participant is waited for
+    bridge = {**told, bytes.fromhex(daemon): _told(["_roc_bridge_7"], [gone])}
+    assert incomplete_participants(writers, bridge, {bytes.fromhex(listener_sub)}, nodes | {("/", "_roc_bridge_7")}) == 1
+
+
 def _locator(address: str, port: int) -> bytes:
     """An RTPS UDPv4 locator (RTPS 9.3.2): kind 1, port, the address in the last 4 of 16 bytes."""
     return struct.pack("<iI", 1, port) + bytes(12) + socket.inet_aton(address)
@@ -192,6 +211,60 @@ def test_the_probe_hears_the_guid_prefix_of_each_participant_of_this_host_that_a
     unreadable = LocalParticipantProbe(202, (tmp_path / "missing",))
     assert unreadable.ask() == 0  # not Linux
     unreadable.close()
+
+
+def _submessage(kind: int, body: bytes) -> bytes:
+    return struct.pack("<BBH", kind, 0x01, len(body)) + body  # little endian
+
+
+def test_an_rtps_message_is_undirected_by_leaving_out_its_info_dst() -> None:
+    header = b"RTPS\x02\x01\x01\x10" + bytes.fromhex(CYCLONE_PREFIX)
+    data = _submessage(0x15, bytes(40))  # a DATA
+    info_ts, invalid_ts = _submessage(0x09, bytes(8)), struct.pack("<BBH", 0x09, 0x03, 0)  # a time, none (length 0)
+    info_dst = _submessage(0x0E, bytes.fromhex("28ef312b86f1396505bf5ca0"))
+    assert undirected(header + info_dst + info_ts + data) == header + info_ts + data
+    assert undirected(header + invalid_ts + info_dst + data) == header + invalid_ts + data
+    assert undirected(header + info_ts + data) is None  # for anyone already
+    assert undirected(b"not RTPS at all") is None
+
+
+def test_the_probe_passes_an_answer_directed_to_the_stand_in_on_undirected_to_this_process_s_participants(
+        tmp_path: Path) -> None:
+    """Domain 203, above the tests' domains: Cyclone DDS answers the stand-in with an announcement whose
+    INFO_DST names the stand-in, which a Fast DDS participant of this process ignores, and Cyclone
+    answers no participant twice; the probe sends its first answer on to this process's participant
+    (a socket of this process at a participant's ports), without the INFO_DST; an undirected answer
+    (Fast DDS's) is not sent on."""
+    ours, theirs = _bound_at_free_participant_ports(203, 2)
+    table = tmp_path / "udp"
+    own_inode = str(os.fstat(ours.fileno()).st_ino)  # a socket's inode, as /proc/net/udp names it
+    table.write_text(UDP_HEADER + "".join(_udp_line(sock.getsockname()[1] + offset, inode, "0100007F")
+                                          for sock, inode in ((ours, own_inode), (theirs, "99")) for offset in (0, 1)))
+    probe = LocalParticipantProbe(203, (table,))
+    try:
+        assert probe.ask() == 1
+        theirs.settimeout(5)
+        asked = theirs.recv(65536)
+        at = asked.index(struct.pack("<HH", 0x0032, 24)) + 4  # PID_METATRAFFIC_UNICAST_LOCATOR
+        probe_at = (socket.inet_ntoa(asked[at + 20:at + 24]), struct.unpack("<I", asked[at + 4:at + 8])[0])
+        announcement = _submessage(0x09, bytes(8)) + _submessage(0x15, SPDP_WRITER.join([bytes(8), bytes(40)]))
+        header = b"RTPS\x02\x01\x01\x10" + bytes.fromhex(CYCLONE_PREFIX)
+        theirs.sendto(header + _submessage(0x0E, asked[8:20]) + announcement, probe_at)  # to the stand-in
+        theirs.sendto(b"RTPS\x02\x03\x01\x0f" + bytes.fromhex(FAST_DDS_PREFIX) + announcement, probe_at)
+        for _ in range(100):
+            if len(probe.heard()) == 2:
+                break
+            time.sleep(0.05)
+        assert probe.heard() == {bytes.fromhex(CYCLONE_PREFIX), bytes.fromhex(FAST_DDS_PREFIX)}
+        ours.settimeout(5)
+        assert ours.recv(65536) == header + announcement
+        ours.settimeout(0.2)
+        with pytest.raises(socket.timeout):  # the Fast DDS answer was for anyone already
+            ours.recv(65536)
+    finally:
+        probe.close()
+        ours.close()
+        theirs.close()
 
 
 def test_this_process_s_discovery_sockets_are_enlarged_and_no_other_socket() -> None:
@@ -397,6 +470,28 @@ def test_a_first_query_on_the_suite_s_middleware_ends_because_the_graph_is_compl
         stop_all(processes)
     assert seen["why"] == "complete"
     assert {"talker", "listener"} <= set(seen["nodes"])
+
+
+@pytest.mark.slow
+@pytest.mark.rmw
+def test_a_first_query_beside_roc_s_daemon_ends_because_the_graph_is_complete(tmp_path: Path) -> None:
+    """On Cyclone DDS the daemon's participant lists the reader of its first wait after it was destroyed
+    (rmw_cyclonedds 2.2.2): a first query beside the daemon waited out its period (3.5 s, "incomplete")."""
+    if suite_middleware() == CYCLONEDDS:
+        require_cyclonedds()
+    env = graph_env(SLOT, tmp_path)
+    processes = start_nodes([TALKER], env)
+    try:
+        started = roc("daemon", "start", env=env)
+        assert started.returncode == 0, started.stderr
+        listed = roc("node", "list", env=env)  # answered once the daemon's first wait has ended
+        assert "/talker" in listed.stdout.split(), listed.stderr
+        seen = _printed_by(FIRST_QUERY, process_environment(env))
+    finally:
+        roc("daemon", "stop", env=env)
+        stop_all(processes)
+    assert seen["why"] == "complete"
+    assert "talker" in seen["nodes"]
 
 
 @pytest.mark.slow
