@@ -5,6 +5,7 @@ query of a session (no daemon running: each tool starts its own) with its comple
 
     python bench/graph_bench.py [--runs 10] [--no-daemon-runs 3] [--completeness-runs 20]
                                 [--cold-runs 20] [--range LOCALHOST] [--only cold]
+                                [--middlewares fastdds,cyclonedds,mixed]
 
 The graph is the demo graph of the tests (tests/helpers/graph.py: six nodes in three processes) in
 ROS domain 90 with localhost discovery; roc's daemon gets a private runtime directory. The ros2 CLI
@@ -19,6 +20,24 @@ Cold: before each run both tools' daemons are stopped, then ``node list``, ``top
 ``service list`` (each against its warm answer: complete or not), with and without ``--no-daemon``.
 Target: cold roc at most ros2's cold time, complete N of N. ``--range SUBNET`` runs the graph and both
 tools with the default discovery range instead of the tests' LOCALHOST.
+
+Middlewares (``--middlewares fastdds,cyclonedds,mixed``, default fastdds): each set-up in turn on a
+graph of its own, then a summary that puts them side by side.
+- ``fastdds``: the graph, roc and ros2 on the wheels' Fast DDS.
+- ``cyclonedds``: the graph's nodes, roc and ros2 on rmw_cyclonedds (``bash scripts/setup.sh
+  --with-cyclonedds`` builds it in .rmw-stack/), each process as tests/helpers/rmw.py's ``on_middleware``
+  gives it: RMW_IMPLEMENTATION=rmw_cyclonedds_cpp and rmw_cyclonedds' prefix first on AMENT_PREFIX_PATH,
+  which roc needs and no more (it loads the library itself: roc/middleware.py). The wheels' librcl links
+  Fast DDS directly, so every other process of the wheels also needs the library preloaded: the graph's
+  nodes and ros2 get ``LD_PRELOAD=.../lib/librmw_cyclonedds_cpp.so`` (roc.middleware.process_environment,
+  as roc run does), and with it LD_LIBRARY_PATH naming the wheels' libraries (the venv's lib/ and
+  site-packages/ros_*.libs, which the "warm" environment sets anyway, as sourcing the rmw workspace's
+  setup script does): the preloaded library needs librmw_dds_common.so and the others before the
+  wheels' bootstrapper would set that path, and without it Python does not start (exit 127).
+- ``mixed``: the graph, roc and ros2 on Fast DDS, and beside them one Cyclone DDS process on the same
+  domain (a talker on /chatter). Target: its cold first query no slower than fastdds's.
+Targets: on Cyclone, cold roc at most ros2's cold time on Cyclone and complete N of N; warm roc verbs at
+most 1.1x the same verbs on Fast DDS (the summary's ``roc cyclonedds/fastdds``).
 """
 
 from __future__ import annotations
@@ -44,11 +63,18 @@ from helpers.graph import (  # noqa: E402
     stop_all,
     stop_daemon,
 )
+from helpers.rmw import CYCLONEDDS, FASTRTPS, MISSING, STACK, on_middleware  # noqa: E402
+
+from roc.middleware import process_environment  # noqa: E402
 
 COMMANDS = [("topic", "list"), ("topic", "info", "-v", "/chatter"), ("node", "list"),
             ("param", "get", "/motor_controller", "max_speed")]
 COLD_COMMANDS = [("node", "list"), ("topic", "list"), ("service", "list")]
 NODES = ["/fibonacci_server", "/listener", "/map_server", "/motor_controller", "/robot1/odom_pub", "/talker"]
+# the set-ups of --middlewares: the middleware of the graph's nodes and of both tools, and the nodes of
+# Cyclone DDS processes beside them
+CYCLONE_TALKER = [{"name": "cyclone_talker", "publishers": [{"topic": "chatter", "type": "std_msgs/msg/String"}]}]
+SETUPS = {"fastdds": (FASTRTPS, []), "cyclonedds": (CYCLONEDDS, []), "mixed": (FASTRTPS, [CYCLONE_TALKER])}
 
 
 def booted(env: dict[str, str], venv: Path) -> dict[str, str]:
@@ -59,14 +85,24 @@ def booted(env: dict[str, str], venv: Path) -> dict[str, str]:
 
 
 def tool_env(env: dict[str, str], boot: bool) -> dict[str, str]:
-    """Booted with this venv's libraries (the oracle's venv holds the same wheels), or plain."""
+    """Booted with this venv's libraries (the oracle's venv holds the same wheels), or plain (a preloaded
+    middleware keeps the libraries: it needs them before the bootstrapper sets them)."""
     if boot:
         return booted(env, Path(sys.prefix))
-    return {k: v for k, v in env.items() if k not in ("_ROS_WHEELS_BOOTSTRAP_COMPLETE", "LD_LIBRARY_PATH")}
+    plain = {k: v for k, v in env.items() if k not in ("_ROS_WHEELS_BOOTSTRAP_COMPLETE", "LD_LIBRARY_PATH")}
+    if env.get("LD_PRELOAD"):
+        plain["LD_LIBRARY_PATH"] = booted(env, Path(sys.prefix))["LD_LIBRARY_PATH"]
+    return plain
 
 
 def tool(name: str) -> str:
     return str(BIN / "roc") if name == "roc" else str(ORACLE_VENV / "bin" / "ros2")
+
+
+def tool_process_env(name: str, env: dict[str, str]) -> dict[str, str]:
+    """``env`` for a run of ``name``: roc loads RMW_IMPLEMENTATION's middleware itself; ros2, a program of
+    the wheels like any other, gets it preloaded where their librcl links another (docs/middlewares.md)."""
+    return env if name == "roc" else process_environment(env)
 
 
 RUN_BOUND_SECONDS = 60  # a run still going then is stopped and counted as failed, at this time
@@ -78,8 +114,8 @@ def timed(name: str, args: tuple[str, ...], env: dict[str, str], boot: bool = Tr
     failed run of that time."""
     start = time.perf_counter()
     try:
-        done = subprocess.run([tool(name), *args], env=tool_env(env, boot), capture_output=True, text=True,
-                              timeout=RUN_BOUND_SECONDS)
+        done = subprocess.run([tool(name), *args], env=tool_env(tool_process_env(name, env), boot),
+                              capture_output=True, text=True, timeout=RUN_BOUND_SECONDS)
     except subprocess.TimeoutExpired:
         print(f"{name} {' '.join(args)}: still running after {RUN_BOUND_SECONDS} s; stopped", file=sys.stderr)
         return float(RUN_BOUND_SECONDS), "", -1
@@ -87,25 +123,34 @@ def timed(name: str, args: tuple[str, ...], env: dict[str, str], boot: bool = Tr
 
 
 @contextlib.contextmanager
-def live_graph(domain: int, specs: list, discovery_range: str = "LOCALHOST"):
+def live_graph(domain: int, specs: list, discovery_range: str = "LOCALHOST", middleware: str = FASTRTPS,
+               cyclone_specs: list = ()):
     """The ros2 oracle installed, the nodes of ``specs`` running in ROS domain ``domain`` with this
-    discovery range, both tools' daemons started and given a discovery period; everything stopped
-    afterwards. Yields the environment and a fresh work directory."""
+    discovery range on ``middleware`` (those of ``cyclone_specs`` on Cyclone DDS), both tools' daemons
+    started and given a discovery period; everything stopped afterwards. Yields the tools' environment
+    (on ``middleware``) and a fresh work directory."""
     reason = install_oracle()
     if reason:
         raise SystemExit(f"the ros2 CLI is not available: {reason}")
+    if (middleware == CYCLONEDDS or cyclone_specs) and not (STACK / "ready").is_file():
+        raise SystemExit(MISSING)
     with tempfile.TemporaryDirectory(prefix="roc-bench-") as directory:
         work = Path(directory)
         env = graph_env(0, work)  # then its own domain, outside the tests
         env["ROS_DOMAIN_ID"] = str(domain)
         env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = discovery_range
-        processes = start_nodes(specs, env)
+        env = on_middleware(env, middleware)
+        processes = []
         try:
+            processes += start_nodes(specs, env)
+            processes += start_nodes(list(cyclone_specs), on_middleware(env, CYCLONEDDS))
             for name in ("roc", "ros2"):
-                subprocess.run([tool(name), "daemon", "start"], env=env, capture_output=True, timeout=60)
+                subprocess.run([tool(name), "daemon", "start"], env=tool_process_env(name, env), capture_output=True,
+                               timeout=60)
             time.sleep(4)
             yield env, work
         finally:
+            stop_daemons(env)
             stop_daemon(env)
             stop_all(processes)
 
@@ -128,7 +173,8 @@ def compare(env: dict[str, str], runs: int, extra: tuple[str, ...], boot: bool) 
 
 def stop_daemons(env: dict[str, str]) -> None:
     for name in ("roc", "ros2"):
-        subprocess.run([tool(name), "daemon", "stop"], env=tool_env(env, True), capture_output=True, timeout=60)
+        subprocess.run([tool(name), "daemon", "stop"], env=tool_env(tool_process_env(name, env), True),
+                       capture_output=True, timeout=60)
 
 
 def cold(env: dict[str, str], runs: int, extra: tuple[str, ...]) -> list[tuple]:
@@ -155,6 +201,66 @@ def cold(env: dict[str, str], runs: int, extra: tuple[str, ...]) -> list[tuple]:
     return rows
 
 
+def run_setup(setup: str, options: argparse.Namespace) -> dict[str, list[tuple]]:
+    """The warm and no-daemon rows, the completeness counts and the cold rows of one set-up of SETUPS,
+    printed as they come."""
+    middleware, cyclone_specs = SETUPS[setup]
+    results: dict[str, list[tuple]] = {"warm": [], "complete": [], "cold": []}
+    nodes = sorted([*NODES, *(f"/{node['name']}" for spec in cyclone_specs for node in spec)])
+    with live_graph(90, DEMO_GRAPH, options.range, middleware, cyclone_specs) as (env, _):
+        for name in ("roc", "ros2"):  # warm-up
+            timed(name, ("topic", "list"), env)
+        print(f"\nmiddlewares {setup}, discovery range {options.range}")
+        if options.only != "cold":
+            print(f"{'command':50} {'roc s':>7} {'ros2 s':>7} {'roc/ros2':>8}  failed runs roc, ros2")
+            modes = (("warm", (), options.runs, True), ("no daemon", ("--no-daemon",), options.no_daemon_runs, True))
+            for label, extra, runs, boot in modes:
+                for command, roc_time, ros2_time, roc_failed, ros2_failed in compare(env, runs, extra, boot):
+                    results["warm"].append((f"{command} ({label})", roc_time, ros2_time))
+                    print(f"{command + ' (' + label + ')':50} {roc_time:7.3f} {ros2_time:7.3f} "
+                          f"{roc_time / ros2_time:8.2f}  {roc_failed}, {ros2_failed}")
+            for name in ("roc", "ros2"):
+                complete = 0
+                for _ in range(options.completeness_runs):
+                    _, out, _ = timed(name, ("node", "list", "--no-daemon"), env)
+                    complete += out.splitlines() == nodes
+                results["complete"].append((name, complete))
+                print(f"{name} node list --no-daemon complete in {complete} of {options.completeness_runs} runs")
+        if options.only != "warm":
+            print(f"{'first query (no daemon running)':50} {'roc s':>7} {'ros2 s':>7} {'roc/ros2':>8}  "
+                  f"complete runs roc, ros2 (of {options.cold_runs})")
+            for label, extra in (("cold", ()), ("cold, --no-daemon", ("--no-daemon",))):
+                for command, roc_time, ros2_time, roc_complete, ros2_complete in cold(env, options.cold_runs, extra):
+                    results["cold"].append((f"{command} ({label})", roc_time, ros2_time, roc_complete, ros2_complete))
+                    print(f"{command + ' (' + label + ')':50} {roc_time:7.3f} {ros2_time:7.3f} "
+                          f"{roc_time / ros2_time:8.2f}  {roc_complete}, {ros2_complete}")
+    return results
+
+
+def summary(results: dict[str, dict[str, list[tuple]]]) -> None:
+    """The set-ups side by side: per command, roc's and ros2's medians on each, and roc's time on each
+    against its time on fastdds (cyclonedds/fastdds: the warm target; mixed/fastdds: the cold one)."""
+    setups = list(results)
+    for part, title in (("warm", "warm and no daemon"), ("cold", "first query (no daemon running)")):
+        rows = {setup: {row[0]: row for row in results[setup][part]} for setup in setups}
+        commands = [row[0] for row in results[setups[0]][part]]
+        if not commands:
+            continue
+        print(f"\n{title}: roc s / ros2 s (roc/ros2" + (", complete roc, ros2" if part == "cold" else "")
+              + ") per set-up" + ("; roc against roc on fastdds" if "fastdds" in setups and len(setups) > 1 else ""))
+        for command in commands:
+            cells = []
+            for setup in setups:
+                row = rows[setup].get(command)
+                if row is None:
+                    continue
+                cell = f"{setup} {row[1]:.3f}/{row[2]:.3f} ({row[1] / row[2]:.2f}"
+                cells.append(cell + (f", {row[3]}, {row[4]})" if part == "cold" else ")"))
+                if setup != "fastdds" and command in rows.get("fastdds", {}):
+                    cells[-1] += f" {setup}/fastdds {row[1] / rows['fastdds'][command][1]:.2f}"
+            print(f"  {command:42} " + "  ".join(cells))
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=10)
@@ -163,31 +269,16 @@ def main() -> int:
     parser.add_argument("--cold-runs", type=int, default=20)
     parser.add_argument("--range", choices=("LOCALHOST", "SUBNET"), default="LOCALHOST")
     parser.add_argument("--only", choices=("warm", "cold"), help="run only the warm (and no daemon) or cold part")
+    parser.add_argument("--middlewares", default="fastdds",
+                        help=f"comma-separated set-ups, run in turn and summed up side by side: {', '.join(SETUPS)}")
     options = parser.parse_args()
-    with live_graph(90, DEMO_GRAPH, options.range) as (env, _):
-        for name in ("roc", "ros2"):  # warm-up
-            timed(name, ("topic", "list"), env)
-        print(f"discovery range {options.range}")
-        if options.only != "cold":
-            print(f"{'command':50} {'roc s':>7} {'ros2 s':>7} {'roc/ros2':>8}  failed runs roc, ros2")
-            modes = (("warm", (), options.runs, True), ("no daemon", ("--no-daemon",), options.no_daemon_runs, True))
-            for label, extra, runs, boot in modes:
-                for command, roc_time, ros2_time, roc_failed, ros2_failed in compare(env, runs, extra, boot):
-                    print(f"{command + ' (' + label + ')':50} {roc_time:7.3f} {ros2_time:7.3f} "
-                          f"{roc_time / ros2_time:8.2f}  {roc_failed}, {ros2_failed}")
-            for name in ("roc", "ros2"):
-                complete = 0
-                for _ in range(options.completeness_runs):
-                    _, out, _ = timed(name, ("node", "list", "--no-daemon"), env)
-                    complete += out.splitlines() == NODES
-                print(f"{name} node list --no-daemon complete in {complete} of {options.completeness_runs} runs")
-        if options.only != "warm":
-            print(f"{'first query (no daemon running)':50} {'roc s':>7} {'ros2 s':>7} {'roc/ros2':>8}  "
-                  f"complete runs roc, ros2 (of {options.cold_runs})")
-            for label, extra in (("cold", ()), ("cold, --no-daemon", ("--no-daemon",))):
-                for command, roc_time, ros2_time, roc_complete, ros2_complete in cold(env, options.cold_runs, extra):
-                    print(f"{command + ' (' + label + ')':50} {roc_time:7.3f} {ros2_time:7.3f} "
-                          f"{roc_time / ros2_time:8.2f}  {roc_complete}, {ros2_complete}")
+    setups = options.middlewares.split(",")
+    unknown = [setup for setup in setups if setup not in SETUPS]
+    if unknown:
+        parser.error(f"--middlewares: unknown set-up {', '.join(unknown)} (choose from {', '.join(SETUPS)})")
+    results = {setup: run_setup(setup, options) for setup in setups}
+    if len(setups) > 1:
+        summary(results)
     return 0
 
 
