@@ -210,6 +210,8 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{kind}: roc/colcon {figures[kind]['roc'] / figures[kind]['colcon']:.2f}x")
     if "noop" in figures:
         print(f"noop: roc {figures['noop']['roc']:.2f} s, colcon {figures['noop']['colcon']:.2f} s")
+    if "ccache" in figures:  # the filling build is a cold build through ccache (every compile a miss)
+        print(f"ccache: clean build / the filling build {figures['ccache']['clean'] / figures['ccache']['fill']:.2f}x")
     if "ccache" in figures and "cold" in figures:
         print(f"ccache: clean build / roc's cold build {figures['ccache']['clean'] / figures['cold']['roc']:.2f}x")
     if "cluster" in figures:
