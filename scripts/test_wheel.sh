@@ -68,7 +68,7 @@ wheel_holds() {
 import sys, zipfile
 names = set(zipfile.ZipFile(sys.argv[1]).namelist())
 wanted = ["roc/_version.py", "roc/create/templates/python/node.py.j2", "roc/create/license_texts/MIT.txt",
-          "roc/shell/templates/setup.sh.j2", "roc/ros/fastdds_participant.xml", "roc/ros/fastdds3_participant.xml"]
+          "roc/shell/templates/setup.sh.j2", "roc/ros/vendors/fastdds_participant.xml", "roc/ros/vendors/fastdds3_participant.xml"]
 missing = [name for name in wanted if name not in names]
 missing += [] if any(n.endswith(".data/scripts/roc") for n in names) else ["the roc script"]
 missing += [] if any(n.endswith("/licenses/LICENSE") for n in names) else ["LICENSE"]

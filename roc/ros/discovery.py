@@ -220,7 +220,9 @@ class LocalParticipantProbe:
     def _pass_on(self, answer: bytes) -> None:
         """Send an answer directed to the stand-in, undirected, to this process's participants."""
         message = undirected(answer)
-        for address in self._ours if message else ():
+        if message is None:  # no INFO_DST: nothing to pass on (roc.ros.spdp.undirected)
+            return
+        for address in self._ours:
             try:
                 self._socket.sendto(message, address)
             except OSError:  # gone meanwhile, or a full buffer: that peer is heard at its next announcement

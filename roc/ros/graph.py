@@ -15,7 +15,7 @@ import os
 import threading
 import time
 import traceback
-from collections.abc import Callable, Iterator, Mapping, MutableMapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -29,7 +29,6 @@ from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
 
-from roc import distribution
 from roc.errors import RocError
 from roc.ros import vendors
 from roc.ros.discovery import (
@@ -56,6 +55,7 @@ from roc.ros.protocol import (
 )
 from roc.ros.raw_subscription import gid_text
 from roc.ros.type_description import describe
+from roc.ros.vendors.fastdds import PARTICIPANT_PROFILE, use_profile
 
 # A fresh participant's discovery ends as soon as it has heard every participant of this host in its
 # domain (roc.ros.discovery counts them), has discovered every node and endpoint each participant lists
@@ -141,33 +141,6 @@ def _service_endpoint(info) -> dict[str, Any]:
 
 def _names_and_types(pairs) -> list[dict[str, Any]]:
     return [{"name": name, "types": list(types)} for name, types in sorted(pairs)]
-
-
-PROFILE_VARIABLES = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE")  # Fast DDS 2's; 3's
-# roc's Fast DDS profiles by Fast DDS major version: 3 (Kilted on) renamed elements of 2's (Jazzy) and
-# rejects a whole file that has one of 2's names (fastdds3_participant.xml), and 2 does the same
-_HERE = Path(__file__).parent
-PROFILES = {2: (_HERE / "fastdds_participant.xml", _HERE / "fastdds_bridge.xml"),
-            3: (_HERE / "fastdds3_participant.xml", _HERE / "fastdds3_bridge.xml")}
-# this environment's (roc.distribution): every roc participant's, and a bridge's
-PARTICIPANT_PROFILE, BRIDGE_PROFILE = PROFILES[distribution.current().fastdds_major]
-OWN_PROFILES = {str(path) for pair in PROFILES.values() for path in pair}
-
-
-def users_profile(environment: Mapping[str, str] = os.environ) -> str | None:
-    """The Fast DDS profile file the user chose, if any (roc's own do not count)."""
-    return next((environment[v] for v in PROFILE_VARIABLES
-                 if environment.get(v) and environment[v] not in OWN_PROFILES), None)
-
-
-def use_profile(profile: Path, environment: MutableMapping[str, str] = os.environ) -> None:
-    """Have Fast DDS load ``profile`` for this process's participants (it reads the file once, at the
-    first), unless the user chose one or the middleware is not Fast DDS. Only through the variable this
-    distribution's Fast DDS reads first: Kilted's rmw warns on stderr that the other one is deprecated."""
-    if middleware(environment).startswith("rmw_fastrtps") and users_profile(environment) is None:
-        for variable in PROFILE_VARIABLES:  # roc's own, inherited from the roc process that started this one
-            environment.pop(variable, None)
-        environment[distribution.current().profiles_variable] = str(profile)
 
 
 class Graph:

@@ -41,7 +41,8 @@ def test_doctor_reports_the_distribution(tmp_path: Path) -> None:
 PROFILE_PROBE = """
 import json, os, socket
 from roc.ros.discovery import is_metatraffic_port
-from roc.ros.graph import PROFILE_VARIABLES, Graph
+from roc.ros.graph import Graph
+from roc.ros.vendors.fastdds import PROFILE_VARIABLES
 graph = Graph()
 bound = {}
 for fd in map(int, os.listdir("/proc/self/fd")):

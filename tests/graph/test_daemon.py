@@ -235,7 +235,7 @@ def test_a_long_running_daemon_hears_each_new_publisher_from_its_first_message(t
     """A Fast DDS participant that starts while an older one announces itself can miss the older one
     until its next announcement (Fast DDS: every 3 s). Through a daemon that had run a while, echo
     started up to 3 s late on a new publisher, in about half the runs; roc's participants announce
-    themselves every 0.5 s (roc/ros/fastdds_participant.xml)."""
+    themselves every 0.5 s (roc/ros/vendors/fastdds_participant.xml)."""
     env = graph_env(16, tmp_path)
     try:
         assert roc("daemon", "start", env=env).returncode == 0

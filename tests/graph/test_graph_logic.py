@@ -287,7 +287,7 @@ def test_an_action_is_bridged_as_its_services_and_topics() -> None:
 def test_the_loop_guard_checks_the_user_s_profile(tmp_path: Path) -> None:
     from roc.errors import UsageError
     from roc.ros.bridges.domains import Route, loop_guard, two_way
-    from roc.ros.graph import BRIDGE_PROFILE
+    from roc.ros.vendors.fastdds import BRIDGE_PROFILE
 
     both = [Route("/x", 1, 2), Route("/x", 2, 1)]
     assert two_way(both) == ["/x"] and two_way([Route("/x", 1, 2), Route("/x", 1, 3)]) == []
@@ -313,7 +313,7 @@ def test_the_loop_guard_checks_the_user_s_profile(tmp_path: Path) -> None:
     ({"RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"}, None),
 ], ids=["fast-dds", "dynamic", "roc-s-own", "user-profile", "user-profile-fast-dds-3", "cyclone"])
 def test_roc_s_participants_take_roc_s_profile_unless_the_user_chose(environment: dict, chosen: str | None) -> None:
-    from roc.ros.graph import BRIDGE_PROFILE, PARTICIPANT_PROFILE, use_profile
+    from roc.ros.vendors.fastdds import BRIDGE_PROFILE, PARTICIPANT_PROFILE, use_profile
 
     ours = {"participant": str(PARTICIPANT_PROFILE), "bridge": str(BRIDGE_PROFILE)}
     environment = {k: ours.get(v, v) for k, v in environment.items()}

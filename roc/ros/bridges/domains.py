@@ -30,9 +30,10 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from roc.errors import UsageError
 from roc.ros.bridges.services import ServiceLink
 from roc.ros.dataplane import RECEIVE_DEPTH, qos_profile
-from roc.ros.graph import BRIDGE_PROFILE, Graph, users_profile
+from roc.ros.graph import Graph
 from roc.ros.protocol import middleware
 from roc.ros.types import message_class
+from roc.ros.vendors.fastdds import BRIDGE_PROFILE, users_profile
 
 SCAN_SECONDS = 1.0
 BRIDGE_NODE = "_roc_bridge"

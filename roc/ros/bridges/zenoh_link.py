@@ -53,8 +53,9 @@ from roc.ros.bridges.domains import (
 )
 from roc.ros.bridges.zenoh_services import ServiceOffer, ServiceProxy
 from roc.ros.dataplane import qos_profile
-from roc.ros.graph import BRIDGE_PROFILE, Graph
+from roc.ros.graph import Graph
 from roc.ros.types import message_class
+from roc.ros.vendors.fastdds import BRIDGE_PROFILE
 
 SCAN_SECONDS = 1.0
 LINK_NODE = f"{BRIDGE_NODE}_zenoh"  # a bridge's node: domain bridges leave its topics alone too

@@ -3,7 +3,7 @@ roc/distribution.py holds what differs between distributions: every other module
 vendor of a participant, from the vendor id its RTPS GUID prefix starts with) or ``of_middleware`` (the
 vendor of an RMW implementation) instead of assuming one vendor's ways. What works for any RTPS vendor
 (the port formula, a stand-in's announcement, GUID prefixes shared by a participant and its endpoints)
-stays in roc.ros.discovery. Plain data: no rclpy."""
+stays in roc.ros.discovery. No rclpy."""
 
 from __future__ import annotations
 
