@@ -39,9 +39,9 @@ class Event:
 
     def for_task(self, task: str, kind: str) -> Event:
         """This event, told of task ``task`` of kind ``kind`` (a cluster worker's events, emitted here)."""
-        event = object.__new__(type(self))
-        for name, value in self.fields().items():
-            setattr(event, name, value)
+        import copy
+
+        event = copy.copy(self)
         event.task, event.kind = task, kind
         return event
 
