@@ -182,7 +182,7 @@ def combine(parts: dict) -> str:
     return hashlib.sha256(json.dumps(parts, sort_keys=True).encode()).hexdigest()
 
 
-def _names(names: list[str], limit: int = 3) -> str:
+def short_names(names: list[str], limit: int = 3) -> str:
     shown = ", ".join(names[:limit])
     return shown + (f" and {len(names) - limit} more" if len(names) > limit else "")
 
@@ -198,11 +198,11 @@ def changes(before: dict, now: dict) -> list[str]:
             (f"{what} removed", [f for f in old_files if f not in new_files]),
         ):
             if names:
-                reasons.append(f"{label}: {_names(sorted(names))}")
+                reasons.append(f"{label}: {short_names(sorted(names))}")
     for part, label in (("options", "option changed"), ("toolchain", "toolchain changed"),
                         ("dependencies", "dependency changed"), ("underlay", "underlay package changed")):
         old, new = before.get(part, {}), now.get(part, {})
         names = sorted(k for k in old.keys() | new.keys() if old.get(k) != new.get(k))
         if names:
-            reasons.append(f"{label}: {_names(names)}")
+            reasons.append(f"{label}: {short_names(names)}")
     return reasons

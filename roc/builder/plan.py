@@ -7,9 +7,11 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable
+from pathlib import Path
 
 from roc.builder.environment import ENVIRONMENT_FILE, build_environment
 from roc.builder.finish import finish_package
+from roc.builder.interface import install_interface
 from roc.builder.layout import package_prefix
 from roc.builder.state import write_state
 from roc.builder.uptodate import (
@@ -110,7 +112,13 @@ class _PackageBuild:
         self.state = self.fingerprints.compute(self.package)
         if self.remote_keys is not None:  # also for an up-to-date package: its dependents need its key
             self.remote_key = self.remote_keys.key(self.package.name, self.state.parts)
-        return stale_reasons(self.package, self.state, self.options)
+        reasons = stale_reasons(self.package, self.state, self.options)
+        if not reasons and self.state.cut_off():
+            stored = self.state.stored
+            write_state(self.options.build_base / self.package.name, self.state.fingerprint, self.state.files,
+                        self.state.parts, self.remote_key, stored.get("interface"), self.state.interfaces)
+            self.fingerprints.installed(self.package.name, stored.get("interface"))
+        return reasons
 
     def restore(self, context: TaskContext) -> str | None:
         """Restore the package from the remote cache: None when done, else why not."""
@@ -129,8 +137,16 @@ class _PackageBuild:
         write_state(build_dir, None, self.state.files)  # until restored whole
         missed = self.remote.restore(self.package, self.remote_key, context)
         if missed is None:
-            write_state(build_dir, self.state.fingerprint, self.state.files, self.state.parts, self.remote_key)
+            self.record(build_dir, self.state.files)
         return missed
+
+    def record(self, build_dir: Path, files: dict) -> None:
+        """Record the package as built (or restored) as it is now, with the interface it installed."""
+        assert self.state is not None
+        interface = install_interface(build_dir, self.prefix, self.package.name)
+        write_state(build_dir, self.state.fingerprint, files, self.state.parts, self.remote_key, interface,
+                    self.state.interfaces)
+        self.fingerprints.installed(self.package.name, interface)
 
     def run(self, context: TaskContext) -> None:
         package, options = self.package, self.options
@@ -153,6 +169,6 @@ class _PackageBuild:
         build_function(package.type)(context, job, options)
         finish_package(package, job.prefix)
         if self.state is not None and not options.partial():
-            write_state(job.build_dir, self.state.fingerprint, files, self.state.parts, self.remote_key)
+            self.record(job.build_dir, files)
             if self.remote is not None and self.remote.settings.writes and self.remote_key:
                 self.remote.upload(package, self.remote_key, context)

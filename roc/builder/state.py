@@ -1,7 +1,8 @@
 """Per-package build state in ``<build-base>/<pkg>/roc_state.json``: the fingerprint of the last
-successful build and its parts (to say what changed since), and the file stamps that make the next
-check cheap. Written atomically; a damaged
-file is reported and ignored (the package is rebuilt), never trusted."""
+successful build and its parts (to say what changed since), the file stamps that make the next
+check cheap, and the interfaces of what it installed and of what it was built against
+(roc.builder.uptodate).
+Written atomically; a damaged file is reported and ignored (the package is rebuilt), never trusted."""
 
 from __future__ import annotations
 
@@ -31,16 +32,24 @@ def read_record(path: Path, damaged: str, fields: tuple[str, ...] = ("files",)) 
 
 
 def read_state(build_dir: Path) -> dict:
-    return read_record(build_dir / STATE_FILE, "damaged build state; the package will be rebuilt")
+    return read_record(build_dir / STATE_FILE, "damaged build state; the package will be rebuilt",
+                       ("files", "interfaces"))
 
 
 def write_state(build_dir: Path, fingerprint: str | None, files: dict, parts: dict | None = None,
-                remote_key: str | None = None) -> None:
+                remote_key: str | None = None, interface: str | None = None,
+                interfaces: dict[str, str | None] | None = None) -> None:
     """Record ``fingerprint`` (made of ``parts``) as built; None: not up to date (a build started).
-    ``remote_key``: the package's remote cache key (roc.remote_cache.keys), when it has one."""
+    ``remote_key``: the package's remote cache key (roc.remote_cache.keys), when it has one;
+    ``interface``: what it installed for its dependents (roc.builder.interface); ``interfaces``: its
+    dependencies' interfaces it was built against."""
     state = {"fingerprint": fingerprint, "files": files, "parts": parts}
     if remote_key:
         state["remote_key"] = remote_key
+    if interface:
+        state["interface"] = interface
+    if interfaces:
+        state["interfaces"] = interfaces
     write_text_atomic(build_dir / STATE_FILE, json.dumps(state, separators=(",", ":")))
 
 

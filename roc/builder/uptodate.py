@@ -3,6 +3,12 @@
 A build computes each package's fingerprint when its task is dispatched, after its dependencies
 have been built, so it sees what they installed; ``roc work build --explain`` and the cache keys
 compute them all at once, in the same order.
+
+A fingerprint counts a dependency by its fingerprint, so it follows the sources (the CI cache keys
+are computed before anything is built), but a package whose only change is a dependency rebuilt
+without a change to the interface it installs (roc.builder.interface: an edit inside a library's
+implementation) is up to date: its build would make the same files. It is recorded with its new
+fingerprint without being built.
 """
 
 from __future__ import annotations
@@ -16,6 +22,7 @@ from roc.builder.fingerprint import (
     changes,
     combine,
     external_stamp,
+    short_names,
     source_parts,
     source_stamps,
     toolchain_parts,
@@ -29,14 +36,21 @@ from roc.workspace.load import Workspace
 from roc.workspace.package import Package
 
 
-class PackageState(namedtuple("PackageState", ("fingerprint", "parts", "files", "stored"))):
-    """One package now (fingerprint, its parts, the file stamps to store) and at its last build."""
+class PackageState(namedtuple("PackageState", ("fingerprint", "parts", "files", "stored", "interfaces"))):
+    """One package now (fingerprint, its parts, the file stamps to store, its dependencies' interfaces)
+    and at its last build."""
 
     __slots__ = ()
     fingerprint: str
     parts: dict
     files: dict
     stored: dict  # roc_state.json as read: {} when never built
+    interfaces: dict  # of each dependency as installed now; None: not yet built as it is now
+
+    def cut_off(self) -> bool:
+        """Up to date although its fingerprint changed: only dependencies changed, and not their
+        interfaces (stale_reasons said so); record it with its new fingerprint."""
+        return bool(self.stored) and self.stored.get("fingerprint") != self.fingerprint
 
 
 def _options_parts(package: Package, options: BuildOptions) -> dict:
@@ -63,6 +77,7 @@ class Fingerprints:
         self.prefixes = underlay_prefixes(self.environment, options.install_base)
         self._external: dict[str, str | None] = {}
         self._now: dict[str, str] = {}
+        self._interfaces: dict[str, str | None] = {}
         self._sources: dict[str, Path] = {}
         self._toolchains: dict[tuple[str, ...], dict[str, object]] = {}  # by the build type's tools
 
@@ -82,6 +97,17 @@ class Fingerprints:
         if name in self._now:
             return self._now[name]
         return read_state(self.options.build_base / name).get("fingerprint")
+
+    def _interface(self, name: str) -> str | None:
+        """What a dependency installed for its dependents (roc.builder.interface), as built now: None
+        while it waits to be built in this run."""
+        if name not in self._interfaces:  # not selected: as installed
+            self._interfaces[name] = read_state(self.options.build_base / name).get("interface")
+        return self._interfaces[name]
+
+    def installed(self, name: str, interface: str | None) -> None:
+        """Package ``name`` is installed as it is now (built, restored or cut off), with ``interface``."""
+        self._interfaces[name] = interface
 
     def _underlay(self, name: str) -> str | None:
         if name not in self._external:
@@ -108,7 +134,9 @@ class Fingerprints:
             parts["generated"] = source_parts(generated)
         fingerprint = combine(parts)
         self._now[package.name] = fingerprint
-        return PackageState(fingerprint, parts, files, stored)
+        self._interfaces[package.name] = stored.get("interface") if stored.get("fingerprint") == fingerprint else None
+        interfaces = {n: self._interface(n) for n in parts["dependencies"]}
+        return PackageState(fingerprint, parts, files, stored, interfaces)
 
 
 def forced_reasons(options: BuildOptions) -> list[str]:
@@ -131,12 +159,37 @@ def stale_reasons(package: Package, state: PackageState, options: BuildOptions) 
     if stored.get("fingerprint") is None:
         return ["its last build did not succeed"]
     if stored["fingerprint"] != state.fingerprint:
-        return changes(stored.get("parts") or {}, state.parts) or ["built by another version of roc"]
+        before = stored.get("parts") or {}
+        changed = {part for part in before.keys() | state.parts.keys() if before.get(part) != state.parts.get(part)}
+        if changed != {"dependencies"}:
+            return changes(before, state.parts) or ["built by another version of roc"]
+        reasons = _dependency_reasons(before["dependencies"], stored.get("interfaces", {}), state)
+        if reasons:
+            return reasons
     build_dir = options.build_base / package.name
     if not install_intact(package_prefix(options.install_base, package.name, options.merge_install),
                           package.name, build_dir):
         return ["its install is incomplete (files of its last install are missing)"]
     return []
+
+
+def _dependency_reasons(before: dict, built_against: dict, state: PackageState) -> list[str]:
+    """Why a package whose only changes are its dependencies' must be built: the dependencies whose
+    interface changed, or that are still to be built (empty: none, it is up to date)."""
+    changed, waiting = [], []
+    for name in sorted(before.keys() | state.parts["dependencies"].keys()):
+        if before.get(name) == state.parts["dependencies"].get(name):
+            continue
+        interface, recorded = state.interfaces.get(name), built_against.get(name)
+        if interface is None and recorded is not None:
+            waiting.append(name)
+        elif interface is None or interface != recorded:
+            changed.append(name)
+    reasons = [f"dependency changed: {short_names(changed)}"] if changed else []
+    if waiting:
+        reasons.append(f"dependency to be built first: {short_names(waiting)} (then this package only if its "
+                       "interface changes)")
+    return reasons
 
 
 def generation_forced(options: BuildOptions) -> list[str]:

@@ -172,7 +172,8 @@ class _Work:
             what = package.name if package.name == self.work.name else f"the dependency {package.name}"
             raise WorkFailed(f"worker {self.name} could not restore {what}: {missed}")
         state = read_state(build_dir)
-        write_state(build_dir, state.get("fingerprint"), state.get("files", {}), state.get("parts"), key)
+        write_state(build_dir, state.get("fingerprint"), state.get("files", {}), state.get("parts"), key,
+                    state.get("interface"), state.get("interfaces"))
 
     # ----------------------------------------------------------------------------------- a build
 

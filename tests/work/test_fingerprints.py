@@ -92,20 +92,55 @@ def test_stale_reasons(tmp_path: Path) -> None:
     package = Package("p", Path("src/p"), "ros.ament_cmake")
     options = _options(tmp_path)
     parts = {"sources": {"a.c": "1:0"}}
-    assert stale_reasons(package, PackageState("f", parts, {}, {}), options) == ["never built"]
-    assert stale_reasons(package, PackageState("f", parts, {}, {"fingerprint": None}), options) == [
+    assert stale_reasons(package, PackageState("f", parts, {}, {}, {}), options) == ["never built"]
+    assert stale_reasons(package, PackageState("f", parts, {}, {"fingerprint": None}, {}), options) == [
         "its last build did not succeed"]
     stored = {"fingerprint": "old", "parts": {"sources": {"a.c": "0:0"}}}
-    assert stale_reasons(package, PackageState("f", parts, {}, stored), options) == ["files changed: a.c"]
-    assert stale_reasons(package, PackageState("f", parts, {}, {"fingerprint": "old", "parts": parts}), options) == [
+    assert stale_reasons(package, PackageState("f", parts, {}, stored, {}), options) == ["files changed: a.c"]
+    assert stale_reasons(package, PackageState("f", parts, {}, {"fingerprint": "old", "parts": parts}, {}), options) == [
         "built by another version of roc"]
     same = {"fingerprint": "f", "parts": parts}
-    assert stale_reasons(package, PackageState("f", parts, {}, same), options) == [
+    assert stale_reasons(package, PackageState("f", parts, {}, same, {}), options) == [
         "its install is incomplete (files of its last install are missing)"]
     prefix = tmp_path / "install" / "p"
     for marker in (prefix / "share/colcon-core/packages/p", prefix / "share/p/package.dsv"):
         marker.parent.mkdir(parents=True, exist_ok=True)
         marker.write_text("")
     write_state(tmp_path / "build" / "p", "f", {}, parts)
-    assert stale_reasons(package, PackageState("f", parts, {}, same), options) == []
-    assert stale_reasons(package, PackageState("f", parts, {}, same), _options(tmp_path, force=True)) == ["--force"]
+    assert stale_reasons(package, PackageState("f", parts, {}, same, {}), options) == []
+    assert stale_reasons(package, PackageState("f", parts, {}, same, {}), _options(tmp_path, force=True)) == ["--force"]
+
+
+def _installed(tmp_path: Path, name: str) -> None:
+    prefix = tmp_path / "install" / name
+    for marker in (prefix / "share/colcon-core/packages" / name, prefix / "share" / name / "package.dsv"):
+        marker.parent.mkdir(parents=True, exist_ok=True)
+        marker.write_text("")
+
+
+@pytest.mark.parametrize(("built_against", "interface_now", "reasons"), [
+    ({"dep": "i1"}, "i1", []),  # rebuilt, the same interface: up to date, recorded anew
+    ({"dep": "i1"}, "i2", ["dependency changed: dep"]),
+    ({"dep": "i1"}, None, ["dependency to be built first: dep (then this package only if its interface changes)"]),
+    ({}, "i1", ["dependency changed: dep"]),  # recorded by an older roc: not known
+])
+def test_a_dependency_counts_by_its_interface(tmp_path: Path, built_against: dict, interface_now: str | None,
+                                              reasons: list[str]) -> None:
+    package = Package("p", Path("src/p"), "ros.ament_cmake")
+    _installed(tmp_path, "p")
+    before = {"sources": {"a.c": "1:0"}, "dependencies": {"dep": "dep-f1"}}
+    now = {"sources": {"a.c": "1:0"}, "dependencies": {"dep": "dep-f2"}}
+    stored = {"fingerprint": "f1", "parts": before, "interfaces": built_against}
+    state = PackageState("f2", now, {}, stored, {"dep": interface_now})
+    assert stale_reasons(package, state, _options(tmp_path)) == reasons
+    assert state.cut_off()
+
+
+def test_a_dependency_interface_does_not_hide_other_changes(tmp_path: Path) -> None:
+    package = Package("p", Path("src/p"), "ros.ament_cmake")
+    _installed(tmp_path, "p")
+    before = {"sources": {"a.c": "1:0"}, "dependencies": {"dep": "dep-f1"}, "generated": {"x.h": "1:0"}}
+    stored = {"fingerprint": "f1", "parts": before, "interfaces": {"dep": "i1"}}
+    for now, reason in (({**before, "sources": {"a.c": "2:0"}, "dependencies": {"dep": "dep-f2"}}, "files changed: a.c"),
+                        ({"sources": {"a.c": "1:0"}, "dependencies": {"dep": "dep-f2"}}, "generated files removed: x.h")):
+        assert reason in stale_reasons(package, PackageState("f2", now, {}, stored, {"dep": "i1"}), _options(tmp_path))

@@ -40,31 +40,60 @@ def test_noop_rebuild_runs_no_tool(built):
     assert "Starting >>>" not in result.stdout
 
 
-def test_edit_rebuilds_the_package_and_its_dependents_only(built):
+def test_an_edit_inside_a_library_rebuilds_its_package_only(built):
+    """app links core's library, which it loads at run time: an edit of core's implementation changes
+    nothing app would build, and app runs the new code without being relinked."""
     source = built / "src" / "core" / "src" / "core.cpp"
     original = source.read_text()
     time.sleep(1.1)  # CMake's install compares timestamps to the second
     source.write_text(original.replace("42", "43"))
     try:
+        explained = roc("work", "build", "--explain", cwd=built).stdout
+        assert "app: dependency to be built first: core (then this package only if its interface changes)" \
+            in explained.splitlines(), explained
         assert roc("work", "build", cwd=built).returncode == 0
-        assert _built(built) == {"core", "app", "pyp"}  # pyp depends on core (exec_depend)
+        assert _built(built) == {"core"}
         assert "core says 43" in in_sourced_shell(built, "install/app/lib/app/app").stdout
     finally:
+        time.sleep(1.1)
         source.write_text(original)
     assert roc("work", "build", cwd=built).returncode == 0
-    assert _built(built) == {"core", "app", "pyp"}  # back to the old content: a new build of it
+    assert _built(built) == {"core"}  # back to the old content: a new build of it
+    assert "core says 42" in in_sourced_shell(built, "install/app/lib/app/app").stdout
     source.touch()  # a new mtime with the same content changes nothing
     assert roc("work", "build", cwd=built).returncode == 0
     assert _built(built) == set()
 
 
-def test_cmake_args_rebuild_the_cmake_packages_and_their_dependents(built):
+@pytest.mark.parametrize("path, old, new", [
+    ("src/core.cpp", "int core_value()", "int core_extra() { return 1; }\nint core_value()"),  # a symbol added
+    ("include/core/core.hpp", "int core_value();", "int core_value();  // the answer"),  # a header edited
+])
+def test_a_change_to_a_librarys_interface_rebuilds_its_dependents(built, path, old, new):
+    source = built / "src" / "core" / path
+    original = source.read_text()
+    time.sleep(1.1)
+    source.write_text(original.replace(old, new))
+    try:
+        assert roc("work", "build", cwd=built).returncode == 0
+        assert _built(built) == {"core", "app", "pyp"}  # pyp depends on core (exec_depend)
+        reasons = {e["task"]: e["reasons"] for e in _events(built) if e["event"] == "TaskStarted"}
+        assert reasons["app"] == ["dependency changed: core"]
+    finally:
+        time.sleep(1.1)
+        source.write_text(original)
+    assert roc("work", "build", cwd=built).returncode == 0
+    assert _built(built) == {"core", "app", "pyp"}
+
+
+def test_cmake_args_rebuild_the_cmake_packages_only(built):
+    """pyp (Python) depends on core, whose rebuild with an unused variable installs the same files."""
     assert roc("work", "build", "--cmake-args", "-DROC_TEST_OPTION=1", cwd=built).returncode == 0
-    assert _built(built) == {"core", "app", "plain", "pyp"}
+    assert _built(built) == {"core", "app", "plain"}
     assert roc("work", "build", "--cmake-args", "-DROC_TEST_OPTION=1", cwd=built).returncode == 0
     assert _built(built) == set()
     assert roc("work", "build", cwd=built).returncode == 0  # back to no arguments
-    assert _built(built) == {"core", "app", "plain", "pyp"}
+    assert _built(built) == {"core", "app", "plain"}
 
 
 def test_deleted_install_or_build_directory_rebuilds(built):
