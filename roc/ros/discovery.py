@@ -26,6 +26,11 @@ them only at their next periodic announcement: it asks them to announce themselv
 (``ask_local_participants_to_announce``, roc.ros.spdp), with input buffers large enough for all their
 answers at once (``enlarge_input_buffers``).
 
+A fresh Cyclone DDS participant drops the first HEARTBEATs of the participants that answer it, so it
+would hear a Fast DDS participant's endpoints and ``ros_discovery_info`` only at that writer's next
+periodic HEARTBEAT (roc.ros.vendors.cyclonedds): the probe prompts them, by the GUID prefixes and
+locators they answered with, to send one at once (``writers_to_prompt``, ``LocalParticipantProbe.prompt``).
+
 Participants on other hosts (a discovery range beyond this host) cannot be counted: the caller waits
 for the graph to go quiet for them. This module reads /proc and rclpy endpoint infos and sends UDP
 datagrams; it never imports rclpy itself (``roc tui`` finds each node's process with it too).
@@ -43,7 +48,17 @@ from pathlib import Path
 from typing import Any
 
 from roc.ros.protocol import is_own_node
-from roc.ros.spdp import announced_properties, stand_in_announcement, undirected
+from roc.ros.spdp import (
+    PID_DEFAULT_UNICAST_LOCATOR,
+    SEDP_PUBLICATIONS,
+    SEDP_SUBSCRIPTIONS,
+    acknack_prompt,
+    announced_locators,
+    announced_properties,
+    is_builtin,
+    stand_in_announcement,
+    undirected,
+)
 
 PORT_BASE = 7400
 DOMAIN_GAIN = 250
@@ -55,8 +70,10 @@ MAX_PARTICIPANT_ID = 119  # the highest id whose ports stay within the domain's 
 DISCOVERY_TOPIC = "ros_discovery_info"  # a DDS name, outside ROS's conventions (no rt/ prefix)
 UDP_TABLES = (Path("/proc/net/udp"), Path("/proc/net/udp6"))
 GUID_PREFIX_BYTES = 12
+ENTITY_ID = slice(GUID_PREFIX_BYTES, GUID_PREFIX_BYTES + 4)  # of a GUID (an endpoint GID): after its prefix
 RTPS_HEADER_BYTES = 20  # "RTPS", version, vendor id, then the sender's GUID prefix (RTPS 8.3.3.1)
 ASK_AGAIN_SECONDS = 0.5  # LocalParticipantProbe.ask_again: at most this often
+PROMPT_AGAIN_SECONDS = 0.2  # LocalParticipantProbe.prompt: the same prompt to a participant at most this often
 INPUT_BUFFER_BYTES = 4 * 1024 * 1024  # what a participant's discovery socket asks for (enlarge_input_buffers)
 
 
@@ -170,7 +187,8 @@ class LocalParticipantProbe:
     5 ms), and no vendor's GUID layout is read. The first answer of each that was directed to the
     stand-in (Cyclone DDS's) goes on, undirected, to this process's participants in the domain
     (roc.ros.spdp.undirected: a Fast DDS participant beside a Cyclone one otherwise heard it up to 1 s
-    later, in 1 to 5 of 8 first queries here)."""
+    later, in 1 to 5 of 8 first queries here). ``prompt`` asks the writers of a participant that answered
+    for a HEARTBEAT, at the locators of its answer."""
 
     def __init__(self, domain_id: int, tables: tuple[Path, ...] = UDP_TABLES) -> None:
         self.domain_id = domain_id
@@ -181,6 +199,10 @@ class LocalParticipantProbe:
         self._heard: dict[bytes, dict[str, str]] = {}  # GUID prefix -> the properties it announced
         self._asked_at: float | None = None
         self._ours: list[tuple[str, int]] = []  # this process's participants' discovery ports
+        # GUID prefix -> the locators it announced: of its discovery traffic, of its endpoints'
+        self._locators: dict[bytes, tuple[list[tuple[str, int]], list[tuple[str, int]]]] = {}
+        # (GUID prefix, the endpoints prompted) -> when (prompt)
+        self._prompted_at: dict[tuple[bytes, tuple[tuple[bytes, bytes], ...]], float] = {}
 
     def ask(self) -> int:
         """Ask every participant of another process on this host to announce itself to the probe; returns
@@ -216,6 +238,9 @@ class LocalParticipantProbe:
                 if prefix not in self._heard:
                     self._pass_on(message)
                 self._heard[prefix] = announced_properties(message) or self._heard.get(prefix, {})
+                locators = (announced_locators(message), announced_locators(message, PID_DEFAULT_UNICAST_LOCATOR))
+                if any(locators):
+                    self._locators[prefix] = locators
 
     def _pass_on(self, answer: bytes) -> None:
         """Send an answer directed to the stand-in, undirected, to this process's participants."""
@@ -227,6 +252,30 @@ class LocalParticipantProbe:
                 self._socket.sendto(message, address)
             except OSError:  # gone meanwhile, or a full buffer: that peer is heard at its next announcement
                 continue
+
+    def prompt(self, reader_prefix: bytes, writer_prefix: bytes, endpoints: list[tuple[bytes, bytes]],
+               count: int) -> bool:
+        """Send the participant ``writer_prefix`` that answered ACKNACKs of this process's participant
+        ``reader_prefix`` for ``endpoints`` (reader and writer entity ids) numbered ``count``
+        (roc.ros.spdp.acknack_prompt): those of built-in writers (discovery's) at the metatraffic locators
+        it announced, the others at its default ones, where it takes each (roc.ros.vendors.fastdds).
+        Not when it was sent the same in the last PROMPT_AGAIN_SECONDS; returns whether they went."""
+        now, key = time.monotonic(), (writer_prefix, tuple(endpoints))
+        if writer_prefix not in self._locators or \
+                now - self._prompted_at.get(key, -PROMPT_AGAIN_SECONDS) < PROMPT_AGAIN_SECONDS:
+            return False
+        self._prompted_at[key] = now
+        for locators, builtin in zip(self._locators[writer_prefix], (True, False)):
+            chosen = [pair for pair in endpoints if is_builtin(pair[1]) == builtin]
+            if not chosen:
+                continue
+            message = acknack_prompt(reader_prefix, writer_prefix, chosen, count)
+            for address, port in locators:
+                try:
+                    self._socket.sendto(message, (_reachable(address), port))
+                except OSError:  # gone meanwhile, or a full buffer: prompted again on the next call
+                    continue
+        return True
 
     def close(self) -> None:
         self._socket.close()
@@ -298,6 +347,29 @@ def local_peers_discovered(expected: int | None, heard: set[bytes], writers: lis
         return None
     discovered = {participant_prefix(bytes(info.endpoint_gid)) for info in writers}
     return len(heard) >= expected and heard <= discovered
+
+
+def own_participant(told: Mapping[bytes, Told], node_name: str) -> bytes | None:
+    """The GUID prefix of this process's participant: the one whose ``ros_discovery_info`` message
+    (``told``, by participant GUID prefix) lists its node ``node_name`` (its own messages come to it too);
+    None before it has come."""
+    return next((prefix for prefix, latest in told.items() if any(name == node_name for _, name in latest.nodes)),
+                None)
+
+
+def writers_to_prompt(own: bytes, heard: set[bytes], told: Mapping[bytes, Told], writers: list[Any],
+                      readers: list[Any]) -> dict[bytes, list[tuple[bytes, bytes]]]:
+    """By GUID prefix, each participant of this host that answered the probe (``heard``) and whose
+    ``ros_discovery_info`` message has not come (``told``): which of its writers to prompt to send this
+    process's participant ``own`` a HEARTBEAT, as (reader, writer) entity ids: its endpoint discovery
+    writers for own's, and, once it is discovered (``writers``: rclpy endpoint infos of the topic's
+    writers), its ``ros_discovery_info`` writer for own's readers of the topic (``readers``)."""
+    ours = [bytes(info.endpoint_gid)[ENTITY_ID] for info in readers
+            if participant_prefix(bytes(info.endpoint_gid)) == own]
+    theirs = {participant_prefix(bytes(info.endpoint_gid)): bytes(info.endpoint_gid)[ENTITY_ID] for info in writers}
+    return {prefix: [SEDP_PUBLICATIONS, SEDP_SUBSCRIPTIONS, *((reader, theirs[prefix]) for reader in ours
+                                                               if prefix in theirs)]
+            for prefix in sorted(heard - told.keys() - {own})}
 
 
 @dataclass(frozen=True)

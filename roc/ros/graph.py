@@ -41,6 +41,8 @@ from roc.ros.discovery import (
     incomplete_participants,
     local_participant_count,
     local_peers_discovered,
+    own_participant,
+    writers_to_prompt,
 )
 from roc.ros.discovery_info import DiscoveryInfoReader
 from roc.ros.params import WRITES, parameter_value
@@ -70,6 +72,9 @@ from roc.ros.vendors.fastdds import PARTICIPANT_PROFILE, use_profile
 QUIET_SECONDS = 0.3
 LOCAL_QUIET_SECONDS = 0.1
 POLL_SECONDS = 0.05
+# how often while roc prompts writers (Graph._prompt_writers), within PROMPT_POLL_LIMIT of the start: each
+# answer acted on at once; after that second Fast DDS's endpoint discovery writers have sent their next HEARTBEAT
+PROMPT_POLL_SECONDS, PROMPT_POLL_LIMIT = 0.01, 1.0
 SERVICE_TIMEOUT = 5.0
 KEPT_CLIENTS = 16  # clients of nodes' own services a graph keeps (Graph._node_service_client)
 LOG = logging.getLogger(__name__)  # the daemon writes it to its log; a library adds no handler of its own
@@ -254,16 +259,20 @@ class Graph:
         domain = self.context.get_domain_id()
         reader = DiscoveryInfoReader(self.node)
         probe = LocalParticipantProbe(domain) if vendors.speaks_rtps(middleware()) else None
+        prompter = probe if vendor is not None and vendor.loses_early_heartbeats else None
         try:
             start = last_change = time.monotonic()
             if probe is not None:
                 probe.ask()
-            last = self.signature()
+            last, prompting = self.signature(), prompter is not None
             while True:
-                time.sleep(POLL_SECONDS)
+                soon = prompting and time.monotonic() - start < PROMPT_POLL_LIMIT
+                time.sleep(PROMPT_POLL_SECONDS if soon else POLL_SECONDS)
                 now = time.monotonic()
                 current = self.signature()
                 told = reader.take()
+                if prompter is not None:
+                    prompting = self._prompt_writers(prompter, told)
                 if current != last:
                     last, last_change = current, now
                 elapsed = now - start
@@ -281,6 +290,28 @@ class Graph:
             if probe is not None:
                 probe.close()
             reader.close()
+
+    def _prompt_writers(self, probe: LocalParticipantProbe, told: Mapping[bytes, Told]) -> bool:
+        """Prompt the writers that tell of this host's participants not wholly heard yet (``told``: no
+        message of theirs has come) to send this participant a HEARTBEAT, where their vendor takes a
+        prompt (roc.ros.vendors.fastdds; why: roc.ros.vendors.cyclonedds). Returns whether it may prompt
+        more: this participant's own message has not come yet, or a participant prompted is not heard
+        wholly yet."""
+        own = own_participant(told, self.node.get_name())
+        if own is None:
+            return True
+        if not probe.heard() - told.keys():
+            return False
+        node = self.node
+        writers = node.get_publishers_info_by_topic(DISCOVERY_TOPIC, no_mangle=True)
+        readers = node.get_subscriptions_info_by_topic(DISCOVERY_TOPIC, no_mangle=True)
+        prompted = False
+        for prefix, endpoints in writers_to_prompt(own, probe.heard(), told, writers, readers).items():
+            vendor = vendors.of_prefix(prefix)
+            if vendor is not None and vendor.prompt_count is not None:
+                probe.prompt(own, prefix, endpoints, vendor.prompt_count)
+                prompted = True
+        return prompted
 
     def _local_peers_discovered(self, domain: int, probe: LocalParticipantProbe | None) -> bool | None:
         """Every participant of another process on this host in ``domain`` has been discovered

@@ -1,9 +1,10 @@
-"""The one RTPS message roc writes itself: a participant announcement (SPDP DATA(p), RTPS 2.3 8.5.3 and
+"""The RTPS messages roc writes itself: a participant announcement (SPDP DATA(p), RTPS 2.3 8.5.3 and
 9.6.2) of a short-lived stand-in participant that names roc's own participant's discovery port; what roc
-reads of the announcements that answer it, their properties (``announced_properties``); and such an
-answer made fit for roc's own participant (``undirected``).
+reads of the announcements that answer it, their properties (``announced_properties``) and locators
+(``announced_locators``); such an answer made fit for roc's own participant (``undirected``); and the
+ACKNACKs that prompt a writer to send roc's participant a HEARTBEAT (``acknack_prompt``).
 
-Why: a Fast DDS participant (2.14 and 3.x alike) sends its first announcement before it listens
+Why the stand-in: a Fast DDS participant (2.14 and 3.x alike) sends its first announcement before it listens
 (RTPSParticipantImpl::enable), so the announcements other participants send back at once to the newcomer
 are lost, and it hears them only at their next periodic announcement, up to 3 s later. Every participant
 answers a participant it has not seen before by announcing itself to that participant's metatraffic
@@ -11,6 +12,10 @@ locators (Fast DDS's PDPStatelessWriter marks it an interested reader); the stan
 fresh participant's own port, so the answers reach a participant that now listens. The stand-in has only
 the announcement endpoints (no endpoint discovery, no ROS enclave: rmw ignores it) and a lease of one
 second, after which every participant forgets it.
+
+Why the prompts: a fresh Cyclone DDS participant drops the first HEARTBEATs of the participants that
+answer it, and Fast DDS's writers send the next only a period later (roc.ros.vendors.cyclonedds); an
+ACKNACK of the reader makes them send one at once (roc.ros.vendors.fastdds).
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ from __future__ import annotations
 import ipaddress
 import os
 import struct
+from collections.abc import Iterator, Sequence
 
 VENDOR_UNKNOWN = b"\x00\x00"  # roc is no DDS vendor (RTPS 9.3.1.5)
 PROTOCOL_VERSION = b"\x02\x03"
@@ -41,9 +47,13 @@ PID_BUILTIN_ENDPOINT_SET = 0x0058
 PID_PROPERTY_LIST = 0x0059
 FLAG_LITTLE_ENDIAN, FLAG_INLINE_QOS = 0x01, 0x02
 PARTICIPANT_ANNOUNCER_AND_DETECTOR = 0x3  # the only builtin endpoints the stand-in has
+SUBMESSAGE_ACKNACK = 0x06
 SUBMESSAGE_INFO_DST = 0x0E  # what follows in the message is for the participant it names only (RTPS 8.3.7.7)
 ZERO_LENGTH_SUBMESSAGES = (0x01, 0x09)  # PAD and INFO_TS: a length of 0 is theirs; any other's runs to the end
 LEASE_SECONDS = 1
+# the endpoint discovery (SEDP) endpoints every participant has (RTPS 9.3.1.3): (reader, writer) entity ids
+SEDP_PUBLICATIONS = (bytes.fromhex("000003c7"), bytes.fromhex("000003c2"))
+SEDP_SUBSCRIPTIONS = (bytes.fromhex("000004c7"), bytes.fromhex("000004c2"))
 
 
 def _parameter(pid: int, value: bytes) -> bytes:
@@ -82,24 +92,57 @@ def announced_properties(message: bytes) -> dict[str, str]:
     """The properties (PID_PROPERTY_LIST) of the participant announcement in an RTPS message, {} when it
     holds none. Cyclone DDS names its participant's host and process there (``__Hostname``, ``__Pid``,
     ``__ProcessName``), which no rmw call tells."""
-    offset = 20  # after the RTPS header
-    if not message.startswith(b"RTPS"):
-        return {}
     try:
-        while offset + 4 <= len(message):
-            kind, flags = message[offset], message[offset + 1]
-            order = "<" if flags & FLAG_LITTLE_ENDIAN else ">"
-            (length,) = struct.unpack_from(order + "H", message, offset + 2)
-            body, offset = offset + 4, (len(message) if length == 0 else offset + 4 + length)
-            if kind == SUBMESSAGE_DATA and message[body + 8:body + 12] == SPDP_WRITER:
-                (to_inline_qos,) = struct.unpack_from(order + "H", message, body + 2)
-                payload = body + 4 + to_inline_qos
-                if flags & FLAG_INLINE_QOS:
-                    payload = _parameters_end(message, payload, order)
-                return _properties(message, payload)
+        for pid, at, order in _announced_parameters(message):
+            if pid == PID_PROPERTY_LIST:
+                (count,) = struct.unpack_from(order + "I", message, at)
+                at, found = at + 4, {}
+                for _ in range(count):
+                    name, at = _string(message, at, order)
+                    value, at = _string(message, at, order)
+                    found[name] = value
+                return found
     except (struct.error, IndexError, UnicodeDecodeError):
         pass
     return {}
+
+
+def announced_locators(message: bytes, pid_wanted: int = PID_METATRAFFIC_UNICAST_LOCATOR) -> list[tuple[str, int]]:
+    """The UDPv4 unicast locators (address, port) of the participant announcement in an RTPS message, []
+    when it holds none: its metatraffic ones (where the participant takes the traffic of its built-in
+    endpoints: discovery), or with ``pid_wanted=PID_DEFAULT_UNICAST_LOCATOR`` its default ones (its
+    endpoints' traffic, unless an endpoint announces locators of its own)."""
+    locators = []
+    try:
+        for pid, at, order in _announced_parameters(message):
+            if pid == pid_wanted:
+                kind, port = struct.unpack_from(order + "iI", message, at)
+                if kind == LOCATOR_KIND_UDPV4:
+                    locators.append((str(ipaddress.IPv4Address(message[at + 20:at + 24])), port))
+    except (struct.error, IndexError, ValueError):
+        return []
+    return locators
+
+
+def _announced_parameters(message: bytes) -> Iterator[tuple[int, int, str]]:
+    """Each parameter of the participant announcement (the SPDP writer's DATA) in an RTPS message: its id,
+    where its value starts and the byte order of the list ("<" or ">"); none when the message holds no
+    announcement. Raises struct.error or IndexError on a message cut short."""
+    offset = 20  # after the RTPS header
+    if not message.startswith(b"RTPS"):
+        return
+    while offset + 4 <= len(message):
+        kind, flags = message[offset], message[offset + 1]
+        order = "<" if flags & FLAG_LITTLE_ENDIAN else ">"
+        (length,) = struct.unpack_from(order + "H", message, offset + 2)
+        body, offset = offset + 4, (len(message) if length == 0 else offset + 4 + length)
+        if kind == SUBMESSAGE_DATA and message[body + 8:body + 12] == SPDP_WRITER:
+            (to_inline_qos,) = struct.unpack_from(order + "H", message, body + 2)
+            payload = body + 4 + to_inline_qos
+            if flags & FLAG_INLINE_QOS:
+                payload = _parameters_end(message, payload, order)
+            yield from _parameters(message, payload)
+            return
 
 
 def _parameters_end(message: bytes, offset: int, order: str) -> int:
@@ -111,24 +154,17 @@ def _parameters_end(message: bytes, offset: int, order: str) -> int:
             return offset
 
 
-def _properties(message: bytes, payload: int) -> dict[str, str]:
-    """The PID_PROPERTY_LIST of the serialized parameter list (PL_CDR_LE or _BE) at ``payload``."""
+def _parameters(message: bytes, payload: int) -> Iterator[tuple[int, int, str]]:
+    """Each parameter (id, where its value starts, byte order) of the serialized parameter list (PL_CDR_LE
+    or _BE) at ``payload``, up to its sentinel."""
     order = "<" if message[payload + 1] == 0x03 else ">"
     offset = payload + 4
     while offset + 4 <= len(message):
         pid, length = struct.unpack_from(order + "HH", message, offset)
         if pid == PID_SENTINEL:
-            break
-        if pid == PID_PROPERTY_LIST:
-            (count,) = struct.unpack_from(order + "I", message, offset + 4)
-            at, found = offset + 8, {}
-            for _ in range(count):
-                name, at = _string(message, at, order)
-                value, at = _string(message, at, order)
-                found[name] = value
-            return found
+            return
+        yield pid, offset + 4, order
         offset += 4 + length
-    return {}
 
 
 def _string(message: bytes, offset: int, order: str) -> tuple[str, int]:
@@ -163,3 +199,22 @@ def undirected(message: bytes) -> bytes | None:
     except struct.error:
         return None
     return b"".join(kept) if directed else None
+
+
+def acknack_prompt(reader_prefix: bytes, writer_prefix: bytes, endpoints: Sequence[tuple[bytes, bytes]],
+                   count: int) -> bytes:
+    """One RTPS message from the participant whose GUID prefix is ``reader_prefix`` to the one whose
+    prefix is ``writer_prefix`` (INFO_DST): for each (reader entity id, writer entity id) of ``endpoints``,
+    the ACKNACK of a reader that has nothing yet: its set of missing sequence numbers empty from 0, not
+    final (as a Fast DDS reader's first, WriterProxy::perform_initial_ack_nack), numbered ``count``."""
+    info_dst = bytes([SUBMESSAGE_INFO_DST, FLAG_LITTLE_ENDIAN]) + struct.pack("<H", len(writer_prefix)) + writer_prefix
+    acknacks = b"".join(
+        bytes([SUBMESSAGE_ACKNACK, FLAG_LITTLE_ENDIAN]) + struct.pack("<H", 24) + reader + writer
+        + struct.pack("<iIII", 0, 0, 0, count)  # base 0 (high, low), no bits, the count
+        for reader, writer in endpoints)
+    return b"RTPS" + PROTOCOL_VERSION + VENDOR_UNKNOWN + reader_prefix + info_dst + acknacks
+
+
+def is_builtin(entity_id: bytes) -> bool:
+    """Whether ``entity_id`` is a built-in endpoint's (RTPS 9.3.1.2: its kind's two high bits set)."""
+    return entity_id[3] & 0xC0 == 0xC0

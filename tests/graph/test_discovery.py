@@ -32,9 +32,21 @@ from roc.ros.discovery import (
     local_participant_count,
     local_peers_discovered,
     metatraffic_sockets,
+    own_participant,
     own_socket_inodes,
+    writers_to_prompt,
 )
-from roc.ros.spdp import SPDP_WRITER, stand_in_announcement, undirected
+from roc.ros.spdp import (
+    PID_DEFAULT_UNICAST_LOCATOR,
+    SEDP_PUBLICATIONS,
+    SEDP_SUBSCRIPTIONS,
+    SPDP_WRITER,
+    acknack_prompt,
+    announced_locators,
+    is_builtin,
+    stand_in_announcement,
+    undirected,
+)
 from roc.ros.vendors.fastdds import process_bits
 
 SLOT = 67
@@ -267,6 +279,111 @@ def test_the_probe_passes_an_answer_directed_to_the_stand_in_on_undirected_to_th
         theirs.close()
 
 
+def _announcement(prefix: bytes, metatraffic: tuple[str, int], default: tuple[str, int]) -> bytes:
+    """An RTPS message holding a participant announcement (SPDP DATA, PL_CDR_LE) with these unicast
+    locators, as a participant answers the stand-in's."""
+    def locator(pid: int, address: tuple[str, int]) -> bytes:
+        return struct.pack("<HHiI", pid, 24, 1, address[1]) + bytes(12) + socket.inet_aton(address[0])
+    parameters = locator(0x0032, metatraffic) + locator(0x0031, default) + struct.pack("<HH", 0x0001, 0)
+    data = struct.pack("<HH", 0, 16) + bytes.fromhex("000100c7") + SPDP_WRITER + struct.pack("<iI", 0, 1) \
+        + b"\x00\x03\x00\x00" + parameters
+    return b"RTPS\x02\x03\x01\x0f" + prefix + _submessage(0x09, bytes(8)) + _submessage(0x15, data)
+
+
+def test_an_announcement_tells_where_its_participant_takes_discovery_traffic_and_its_endpoints_traffic() -> None:
+    answer = _announcement(bytes.fromhex(FAST_DDS_PREFIX), ("192.0.2.2", 7412), ("192.0.2.2", 7413))
+    assert announced_locators(answer) == [("192.0.2.2", 7412)]
+    assert announced_locators(answer, PID_DEFAULT_UNICAST_LOCATOR) == [("192.0.2.2", 7413)]
+    stand_in = stand_in_announcement(5, [("127.0.0.1", 7412), ("127.0.0.1", 7414)])
+    assert announced_locators(stand_in) == announced_locators(stand_in, PID_DEFAULT_UNICAST_LOCATOR) \
+        == [("127.0.0.1", 7412), ("127.0.0.1", 7414)]
+    assert announced_locators(answer[:-40]) == []  # cut short
+    assert announced_locators(b"RTPS" + bytes(30)) == announced_locators(b"not RTPS at all") == []
+
+
+def test_an_acknack_prompt_is_a_reader_s_first_acknack_to_each_writer_numbered_as_asked() -> None:
+    """What a Fast DDS reader sends first (an empty set of sequence numbers from 0, not final), for each
+    (reader, writer) pair, from the reader's participant (the header) to the writer's (INFO_DST)."""
+    reader, writer = bytes.fromhex(CYCLONE_PREFIX), bytes.fromhex(FAST_DDS_PREFIX)
+    discovery_info = (bytes.fromhex("00000504"), bytes.fromhex("00000103"))
+    message = acknack_prompt(reader, writer, [SEDP_PUBLICATIONS, discovery_info], 0xFFFFFFFF)
+    assert message[:20] == b"RTPS\x02\x03\x00\x00" + reader
+    assert message[20:36] == _submessage(0x0E, writer)
+    acknacks = [message[36 + 28 * i:36 + 28 * (i + 1)] for i in range(2)]
+    assert len(message) == 36 + 28 * 2
+    for acknack, (reader_id, writer_id) in zip(acknacks, [SEDP_PUBLICATIONS, discovery_info]):
+        assert acknack[:4] == bytes([0x06, 0x01, 24, 0])  # ACKNACK, little endian, not final
+        assert acknack[4:12] == reader_id + writer_id
+        assert struct.unpack("<iIII", acknack[12:]) == (0, 0, 0, 0xFFFFFFFF)  # base 0, no bits, the count
+    assert [is_builtin(writer_id) for _, writer_id in (SEDP_PUBLICATIONS, SEDP_SUBSCRIPTIONS, discovery_info)] \
+        == [True, True, False]
+
+
+def test_the_writers_prompted_are_those_of_this_host_s_participants_whose_message_has_not_come() -> None:
+    """Their endpoint discovery writers first; their ros_discovery_info writer, for each of this process's
+    readers of the topic, once discovered. Participants of other hosts (not heard) and this process's own
+    are never prompted."""
+    own, fast, told_fast = (bytes.fromhex(p) for p in (CYCLONE_PREFIX, FAST_DDS_PREFIX, "010f" + "cd" * 10))
+    told = {own: _told(["_roc_42"], []), told_fast: _told(["talker"], [])}
+    assert own_participant(told, "_roc_42") == own
+    assert own_participant({told_fast: told[told_fast]}, "_roc_42") is None  # its own message not come yet
+
+    def endpoint(prefix: bytes, entity: str) -> Writer:
+        found = Writer(prefix.hex())
+        found.endpoint_gid = list(prefix + bytes.fromhex(entity))
+        return found
+    readers = [endpoint(own, "00000504"), endpoint(own, "00000704"), endpoint(fast, "00000204")]
+    sedp = [SEDP_PUBLICATIONS, SEDP_SUBSCRIPTIONS]
+    assert writers_to_prompt(own, {own, fast, told_fast}, told, [], readers) == {fast: sedp}
+    writers = [endpoint(fast, "00000103"), endpoint(told_fast, "00000103")]
+    assert writers_to_prompt(own, {own, fast, told_fast}, told, writers, readers) == {fast: [
+        *sedp, (bytes.fromhex("00000504"), bytes.fromhex("00000103")),
+        (bytes.fromhex("00000704"), bytes.fromhex("00000103"))]}
+    assert writers_to_prompt(own, {own, told_fast}, told, writers, readers) == {}
+    # the vendors: Cyclone DDS loses early HEARTBEATs, Fast DDS writers take a prompt whose count wraps
+    cyclone, fast_dds = vendors.of_prefix(own), vendors.of_prefix(fast)
+    assert cyclone.loses_early_heartbeats and cyclone.prompt_count is None
+    assert not fast_dds.loses_early_heartbeats and (fast_dds.prompt_count + 1) % 2 ** 32 == 0
+
+
+def test_the_probe_prompts_a_participant_that_answered_discovery_writers_at_its_metatraffic_port_others_at_its_default_one(
+        tmp_path: Path) -> None:
+    """Domain 204, above the tests' domains: a Fast DDS writer takes an ACKNACK only on the port it listens
+    on for that endpoint (roc.ros.vendors.fastdds)."""
+    [metatraffic] = _bound_at_free_participant_ports(204, 1)
+    default = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    default.bind(("127.0.0.1", metatraffic.getsockname()[1] + 1))
+    table = tmp_path / "udp"
+    table.write_text(UDP_HEADER + "".join(_udp_line(sock.getsockname()[1], "99", "0100007F")
+                                          for sock in (metatraffic, default)))
+    own, fast = bytes.fromhex(CYCLONE_PREFIX), bytes.fromhex(FAST_DDS_PREFIX)
+    discovery_info = (bytes.fromhex("00000504"), bytes.fromhex("00000103"))
+    probe = LocalParticipantProbe(204, (table,))
+    try:
+        assert not probe.prompt(own, fast, [SEDP_PUBLICATIONS], 0xFFFFFFFF)  # it has not answered
+        assert probe.ask() == 1
+        metatraffic.settimeout(5)
+        asked = metatraffic.recv(65536)
+        at = asked.index(struct.pack("<HH", 0x0032, 24)) + 4  # PID_METATRAFFIC_UNICAST_LOCATOR
+        probe_at = (socket.inet_ntoa(asked[at + 20:at + 24]), struct.unpack("<I", asked[at + 4:at + 8])[0])
+        metatraffic.sendto(_announcement(fast, metatraffic.getsockname(), default.getsockname()), probe_at)
+        for _ in range(100):
+            if probe.heard():
+                break
+            time.sleep(0.05)
+        assert probe.prompt(own, fast, [SEDP_PUBLICATIONS, SEDP_SUBSCRIPTIONS, discovery_info], 0xFFFFFFFF)
+        default.settimeout(5)
+        assert metatraffic.recv(65536) == acknack_prompt(own, fast, [SEDP_PUBLICATIONS, SEDP_SUBSCRIPTIONS],
+                                                         0xFFFFFFFF)
+        assert default.recv(65536) == acknack_prompt(own, fast, [discovery_info], 0xFFFFFFFF)
+        assert not probe.prompt(own, fast, [SEDP_PUBLICATIONS, SEDP_SUBSCRIPTIONS, discovery_info], 0xFFFFFFFF)
+        assert probe.prompt(own, fast, [SEDP_PUBLICATIONS], 0xFFFFFFFF)  # another prompt goes at once
+    finally:
+        probe.close()
+        metatraffic.close()
+        default.close()
+
+
 def test_this_process_s_discovery_sockets_are_enlarged_and_no_other_socket() -> None:
     """Domain 201, above the tests' domains: a participant's discovery socket with its user-data socket
     above it; a sender's socket that happens to be at another discovery port (no user-data port above
@@ -492,6 +609,27 @@ def test_a_first_query_beside_roc_s_daemon_ends_because_the_graph_is_complete(tm
         stop_all(processes)
     assert seen["why"] == "complete"
     assert "talker" in seen["nodes"]
+
+
+@pytest.mark.slow
+@pytest.mark.rmw
+@pytest.mark.xdist_group("busy_or_timing")  # its bound is Fast DDS's heartbeat period (see scripts/test.sh)
+def test_a_cyclone_dds_first_query_beside_fast_dds_processes_is_complete_before_their_writers_next_heartbeat(
+        tmp_path: Path) -> None:
+    """A fresh Cyclone DDS participant drops the first HEARTBEATs of the Fast DDS participants that answer it,
+    and their writers sent the next only a period later (1 s for their endpoints, 3 s for their
+    ros_discovery_info): a first query took 2.2 to 3.4 s. roc prompts those writers, so the wait is
+    complete within Fast DDS's endpoint discovery period, 1 s, with time to spare."""
+    require_cyclonedds()
+    env = graph_env(SLOT, tmp_path)
+    processes = start_nodes([TALKER, LISTENER], on_middleware(env, FASTRTPS))
+    try:
+        seen = _printed_by(FIRST_QUERY.replace("wait_for_discovery()", "wait_for_discovery(period=0.9)"),
+                           process_environment(on_middleware(env, CYCLONEDDS)))
+    finally:
+        stop_all(processes)
+    assert seen["why"] == "complete"
+    assert {"talker", "listener"} <= set(seen["nodes"])
 
 
 @pytest.mark.slow

@@ -153,6 +153,9 @@ class FakeGraph:
     def _complete(self, told):
         return True
 
+    def _prompt_writers(self, probe, told) -> bool:  # on Cyclone DDS: no writer to prompt
+        return False
+
     def _local_peers_discovered(self, domain: int, probe) -> bool | None:
         if self.peers_at == "uncountable":
             return None

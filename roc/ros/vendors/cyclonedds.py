@@ -12,6 +12,16 @@ roc's discovery wait adds no announcement period for a Cyclone participant (``la
 asks every participant of this host to announce itself to it at once (roc.ros.discovery), which Cyclone's
 participants, as Fast DDS's, do within milliseconds, and Fast DDS's 3 s period is not Cyclone's.
 
+A fresh Cyclone participant drops the first HEARTBEATs of a participant that answers its announcement
+(``loses_early_heartbeats``): the answer and those HEARTBEATs come in one burst, and Cyclone takes in an
+announcement on another thread than the one that reads the HEARTBEATs after it (0.10's q_receive.c:
+handle_SPDP queues it for dq.builtin; handle_Heartbeat drops a HEARTBEAT of a writer it does not know).
+Its own first ACKNACK to each writer then (q_xevent.c: make_preemptive_acknack, sequence number set from
+1, count 0) makes a Fast DDS writer send nothing, so it heard a Fast DDS participant's endpoints only at
+that writer's next periodic HEARTBEAT (Fast DDS's endpoint discovery: every second) and its
+``ros_discovery_info`` at that writer's (every 3 s): a first query beside Fast DDS processes took 2.2 to
+3.4 s. roc prompts those writers instead (roc.ros.graph, roc.ros.vendors.fastdds).
+
 A service request from a Cyclone client can crash a Fast DDS server of Jazzy (rmw_fastrtps 8.4.3 reads the
 request's header as a sequence length and allocates gigabytes: ros2/rmw_cyclonedds#577), so roc on Cyclone
 calls no service of a Fast DDS node (``crashes_servers_of``)."""
@@ -21,4 +31,4 @@ from __future__ import annotations
 from roc.ros.vendors.vendor import Vendor
 
 VENDOR = Vendor("Cyclone DDS", vendor_id=b"\x01\x10", middlewares=("rmw_cyclonedds_cpp",), late_answer_seconds=0.0,
-                crashes_servers_of=(b"\x01\x0f",), crash_report="ros2/rmw_cyclonedds#577")
+                loses_early_heartbeats=True, crashes_servers_of=(b"\x01\x0f",), crash_report="ros2/rmw_cyclonedds#577")

@@ -8,8 +8,18 @@ A fresh Fast DDS participant sends its first announcement before it listens, so 
 the participants already there only at their next periodic announcement, by default every 3 s
 (``late_answer_seconds``): roc asks them to announce themselves again at once
 (roc.ros.discovery.ask_local_participants_to_announce; why: roc.ros.spdp). roc's own participants take
-roc's own participants take roc's Fast DDS profiles (``PROFILES``; ``use_profile``), unless the user chose a
-profile file."""
+roc's Fast DDS profiles (``PROFILES``; ``use_profile``), unless the user chose a
+profile file.
+
+A Fast DDS writer sends a HEARTBEAT at once to a reader whose ACKNACK has an empty set of sequence numbers
+from 0, as a Fast DDS reader's first ACKNACK has (StatefulWriter::process_acknack, 2.14 and 3.x), if its
+count is not below the next one expected from that reader (ReaderProxy::check_and_set_acknack_count);
+the next one expected is then the count plus one, in 32 bits. roc prompts a Fast DDS writer for a Cyclone
+DDS reader that lost its first HEARTBEATs (roc.ros.vendors.cyclonedds) with the count 0xFFFFFFFF
+(``prompt_count``): always taken, and the next one expected wraps to 0, so every ACKNACK the reader sends
+later is taken too (the reader's own count goes on from 1). The writer takes an ACKNACK on the port it
+listens on for that endpoint: the discovery (metatraffic) port for discovery's endpoints, the default one
+for the others (roc.ros.discovery.LocalParticipantProbe.prompt)."""
 
 from __future__ import annotations
 
@@ -22,7 +32,8 @@ from roc.ros.protocol import middleware
 from roc.ros.vendors.vendor import Vendor
 
 VENDOR = Vendor("Fast DDS", vendor_id=b"\x01\x0f", middlewares=("rmw_fastrtps_cpp", "rmw_fastrtps_dynamic_cpp"),
-                late_answer_seconds=3.0)  # its default period of a participant's announcements
+                late_answer_seconds=3.0,  # its default period of a participant's announcements
+                prompt_count=0xFFFFFFFF)
 
 
 def process_bits(prefix: bytes) -> int | None:

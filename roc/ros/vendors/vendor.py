@@ -16,3 +16,10 @@ class Vendor:
     # the vendor ids of servers a request of this vendor's clients is known to crash
     crashes_servers_of: tuple[bytes, ...] = ()
     crash_report: str = ""  # where that is told
+    # a participant of this vendor drops a writer's HEARTBEATs that come before it has taken in the writer's
+    # participant's announcement, and its own first ACKNACK does not make every vendor's writer send
+    # another: roc prompts the writers of the participants it has not wholly heard yet (roc.ros.graph)
+    loses_early_heartbeats: bool = False
+    # the count of an ACKNACK (roc.ros.spdp.acknack_prompt) that makes a writer of this vendor send a
+    # HEARTBEAT at once and still take every later ACKNACK of that reader; None: roc prompts none
+    prompt_count: int | None = None
