@@ -29,6 +29,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import resource
 import shutil
 import statistics
 import subprocess
@@ -53,6 +54,7 @@ RELEASE = ["--cmake-args", "-DCMAKE_BUILD_TYPE=Release", "-DBUILD_TESTING=OFF"]
 OVERRIDE = ["--allow-overriding", "composition_interfaces"]
 EDITED = Path("rclcpp-28.1.6", "rclcpp", "src", "rclcpp", "node.cpp")
 PHASES = ("cold", "noop", "edit", "ccache", "cluster")
+CORES = len(os.sched_getaffinity(0))
 
 
 def environment() -> dict[str, str]:
@@ -93,14 +95,22 @@ def clean(ws: Path) -> None:
 
 def timed(ws: Path, command: list[str], env: dict[str, str], label: str) -> float:
     print(f"  {label:<28} {load()} ...", end="", flush=True)
+    before = _children_cpu()
     start = time.perf_counter()
     result = subprocess.run(command, cwd=ws, env={**env, "MAKEFLAGS": env.get("MAKEFLAGS", "-j2")},
                             capture_output=True, text=True)
     elapsed = time.perf_counter() - start
     if result.returncode != 0:
         sys.exit(f"\n{' '.join(command)} failed in {ws}:\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}")
-    print(f" {elapsed:8.2f} s")
+    cpu = _children_cpu() - before
+    print(f" {elapsed:8.2f} s, {cpu:7.1f} s of CPU (the floor on {CORES} cores: {cpu / CORES:.1f} s)")
     return elapsed
+
+
+def _children_cpu() -> float:
+    """The CPU time of this process's finished children and their descendants (a build's compilers)."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
 
 
 def install_files(ws: Path) -> set[str]:
@@ -118,9 +128,10 @@ def compare_installs(ours: Path, theirs: Path) -> None:
 
 
 def edit(ws: Path, run: int) -> None:
+    """A new error message in node.cpp, different from every earlier run's (--reuse keeps the last)."""
     source = ws / "src" / EDITED
     text, count = re.subn(r'"failed to validate subnode namespace[^"]*"',
-                          f'"failed to validate subnode namespace (cpp_build_bench edit {run + 1})"', source.read_text())
+                          f'"failed to validate subnode namespace (edit {uuid.uuid4().hex[:8]})"', source.read_text())
     assert count, f"{source}: the edited message is not there"
     source.write_text(text)
 
@@ -175,8 +186,8 @@ def main(argv: list[str] | None = None) -> int:
         if not all((ws / "install").is_dir() for ws in spaces.values()):
             sys.exit(f"cpp_build_bench: --reuse: no earlier build in {WORK}/roc and {WORK}/colcon: run without it")
         wants.discard("cold")
-    else:
-        spaces = {tool: fresh(tool) for tool in tools}
+    else:  # fresh copies only for the phases that use them (a ccache or cluster run keeps the last ones)
+        spaces = {tool: fresh(tool) for tool in tools} if wants & {"cold", "noop", "edit"} else {}
 
     def each(kind: str, prepare) -> None:
         times: dict[str, list[float]] = {tool: [] for tool in tools}
