@@ -57,6 +57,7 @@ from roc.ros.protocol import (
 )
 from roc.ros.raw_subscription import gid_text
 from roc.ros.type_description import describe
+from roc.ros.vendors.cyclonedds import close_at_once
 from roc.ros.vendors.fastdds import PARTICIPANT_PROFILE, use_profile
 
 # A fresh participant's discovery ends as soon as it has heard every participant of this host in its
@@ -156,7 +157,7 @@ class Graph:
     BRIDGE_PROFILE for a bridge's. Both announce the participant every 0.5 s."""
 
     def __init__(self, node_name: str | None = None, domain_id: int | None = None, events: bool = False,
-                 profile: Path = PARTICIPANT_PROFILE, arguments: Sequence[str] = ()) -> None:
+                 profile: Path = PARTICIPANT_PROFILE, arguments: Sequence[str] = (), asks_only: bool = False) -> None:
         """``events``: spin with rclpy's C++ EventsExecutor, which takes a message in a fraction of the
         Python executor's time (at 5 kHz: no loss and 0.2 ms instead of 10 % loss and 60 ms here). In
         rclpy 7.1.6 it never calls a callback that takes message info, so echo and hz take their
@@ -164,12 +165,17 @@ class Graph:
 
         ``arguments``: the node's ROS arguments (``--ros-args --remap OLD:=NEW``, as rosbag2 gives its
         player's). rcl never reads roc's own command line, where it would take any ``NAME:=VALUE`` word
-        for a remapping rule (and warn that this syntax is deprecated)."""
+        for a remapping rule (and warn that this syntax is deprecated).
+
+        ``asks_only``: the participant only queries and waits for the answers to its requests, so it may
+        close without waiting for its last messages to be acknowledged (roc.ros.vendors.cyclonedds)."""
         use_profile(profile)
-        self.context = Context()
-        rclpy.init(args=[], context=self.context, signal_handler_options=SignalHandlerOptions.NO, domain_id=domain_id)
-        OPEN_GRAPHS.add(id(self))
-        self.node = self.task_node(node_name or own_node_name(os.getpid()), arguments)
+        with close_at_once() if asks_only else contextlib.nullcontext():
+            self.context = Context()
+            rclpy.init(args=[], context=self.context, signal_handler_options=SignalHandlerOptions.NO,
+                       domain_id=domain_id)
+            OPEN_GRAPHS.add(id(self))
+            self.node = self.task_node(node_name or own_node_name(os.getpid()), arguments)
         if vendors.speaks_rtps(middleware()):  # DDS's discovery ports and announcements (not rmw_zenoh's)
             enlarge_input_buffers(self.context.get_domain_id())
             ask_local_participants_to_announce(self.context.get_domain_id())

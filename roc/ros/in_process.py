@@ -11,25 +11,16 @@ from roc.ros.protocol import Events
 from roc.ros.streams import run_on
 
 
-def discovered_graph(spin_time: float | None = None, node_name: str | None = None) -> Graph:
+def discovered_graph(spin_time: float | None = None, node_name: str | None = None, asks_only: bool = False) -> Graph:
     """A fresh participant that has waited for discovery (at most ``spin_time``; see
-    Graph.wait_for_discovery for the default)."""
-    graph = Graph(node_name)
+    Graph.wait_for_discovery for the default); ``asks_only``: see Graph."""
+    graph = Graph(node_name, asks_only=asks_only)
     try:
         graph.wait_for_discovery(spin_time)
     except BaseException:
         graph.close()
         raise
     return graph
-
-
-def query(method: str, params: dict[str, Any], spin_time: float | None) -> Any:
-    """Answer one request without a daemon: a fresh participant, discovery, the query."""
-    graph = discovered_graph(spin_time)
-    try:
-        return graph.handle(method, params)
-    finally:
-        graph.close()
 
 
 def stream(method: str, params: dict[str, Any], **in_process: Any) -> Events:
