@@ -187,6 +187,11 @@ def short_names(names: list[str], limit: int = 3) -> str:
     return shown + (f" and {len(names) - limit} more" if len(names) > limit else "")
 
 
+def differing_keys(old: dict, new: dict) -> list[str]:
+    """The keys whose values differ between ``old`` and ``new`` (present in one only included), sorted."""
+    return sorted(k for k in old.keys() | new.keys() if old.get(k) != new.get(k))
+
+
 def changes(before: dict, now: dict) -> list[str]:
     """Why ``now``'s parts differ from ``before``'s, one short reason per kind of change."""
     reasons = []
@@ -201,8 +206,7 @@ def changes(before: dict, now: dict) -> list[str]:
                 reasons.append(f"{label}: {short_names(sorted(names))}")
     for part, label in (("options", "option changed"), ("toolchain", "toolchain changed"),
                         ("dependencies", "dependency changed"), ("underlay", "underlay package changed")):
-        old, new = before.get(part, {}), now.get(part, {})
-        names = sorted(k for k in old.keys() | new.keys() if old.get(k) != new.get(k))
+        names = differing_keys(before.get(part, {}), now.get(part, {}))
         if names:
             reasons.append(f"{label}: {short_names(names)}")
     return reasons

@@ -16,9 +16,10 @@ import os
 import re
 from pathlib import Path
 
+from roc.builder.layout import package_prefix
+from roc.buildtypes.context import BuildOptions
 from roc.fsutil import file_sha256
 
-INSTALL_RECORDS = ("install_manifest.txt", "symlink_install_manifest.txt", "install.log")
 SHARED_LIBRARY = re.compile(r"\.so(\.\d+)*$")
 # A data object's size is part of the interface: a program that copies it (a copy relocation) is
 # linked with its size.
@@ -75,24 +76,16 @@ def _file_part(path: str) -> str:
     return file_sha256(Path(path))
 
 
-def install_interface(build_dir: Path, prefix: Path, name: str) -> str:
-    """The interface of package ``name``'s install: every file its install records list (CMake's
-    install manifests, a Python package's install.log) and the environment hooks roc writes for it."""
-    files: set[str] = set()
-    for record in INSTALL_RECORDS:
-        try:
-            files.update(line for line in (build_dir / record).read_text().splitlines() if line)
-        except (FileNotFoundError, NotADirectoryError):
-            continue
-    share = prefix / "share" / name
-    files.add(str(share / "package.dsv"))
-    hooks = share / "hook"
-    if hooks.is_dir():
-        files.update(str(hook) for hook in hooks.iterdir())
+def install_interface(name: str, root: Path, options: BuildOptions) -> str:
+    """The interface of package ``name``'s install in workspace ``root``: every file it installed
+    (roc.builder.artefact.installed_files: its records, the hooks and scripts roc wrote for it)."""
+    from roc.builder.artefact import Places, installed_files  # not on a no-op build's path (dataclasses)
+
+    prefix = package_prefix(options.install_base, name, options.merge_install)
+    places = Places(root, options.build_base, options.install_base)
     digest = hashlib.sha256()
-    for path in sorted(files):
-        if path.endswith(".pyc"):  # written when Python first imports a module, not by the build
+    for path in installed_files(name, places, options.merge_install):
+        if path.suffix == ".pyc":  # written when Python first imports a module, not by the build
             continue
-        relative = os.path.relpath(path, prefix)
-        digest.update(f"{relative}\0{_file_part(path)}\0".encode())
+        digest.update(f"{path.relative_to(prefix)}\0{_file_part(str(path))}\0".encode())
     return digest.hexdigest()

@@ -143,7 +143,7 @@ class _PackageBuild:
     def record(self, build_dir: Path, files: dict) -> None:
         """Record the package as built (or restored) as it is now, with the interface it installed."""
         assert self.state is not None
-        interface = install_interface(build_dir, self.prefix, self.package.name)
+        interface = install_interface(self.package.name, self.fingerprints.workspace.root, self.options)
         write_state(build_dir, self.state.fingerprint, files, self.state.parts, self.remote_key, interface,
                     self.state.interfaces)
         self.fingerprints.installed(self.package.name, interface)

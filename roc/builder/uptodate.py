@@ -21,6 +21,7 @@ from roc.builder.fingerprint import (
     build_tools,
     changes,
     combine,
+    differing_keys,
     external_stamp,
     short_names,
     source_parts,
@@ -160,8 +161,7 @@ def stale_reasons(package: Package, state: PackageState, options: BuildOptions) 
         return ["its last build did not succeed"]
     if stored["fingerprint"] != state.fingerprint:
         before = stored.get("parts") or {}
-        changed = {part for part in before.keys() | state.parts.keys() if before.get(part) != state.parts.get(part)}
-        if changed != {"dependencies"}:
+        if differing_keys(before, state.parts) != ["dependencies"]:
             return changes(before, state.parts) or ["built by another version of roc"]
         reasons = _dependency_reasons(before["dependencies"], stored.get("interfaces", {}), state)
         if reasons:
@@ -177,9 +177,7 @@ def _dependency_reasons(before: dict, built_against: dict, state: PackageState) 
     """Why a package whose only changes are its dependencies' must be built: the dependencies whose
     interface changed, or that are still to be built (empty: none, it is up to date)."""
     changed, waiting = [], []
-    for name in sorted(before.keys() | state.parts["dependencies"].keys()):
-        if before.get(name) == state.parts["dependencies"].get(name):
-            continue
+    for name in differing_keys(before, state.parts["dependencies"]):
         interface, recorded = state.interfaces.get(name), built_against.get(name)
         if interface is None and recorded is not None:
             waiting.append(name)

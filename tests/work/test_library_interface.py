@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from roc.builder.interface import install_interface, library_interface
+from roc.buildtypes.context import BuildOptions
 
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="needs gcc")
 
@@ -55,23 +56,24 @@ def test_programs_and_other_files_have_no_library_interface(tmp_path: Path) -> N
     assert library_interface(str(tmp_path / "text.so")) is None
 
 
-def _install(prefix: Path, build_dir: Path, library_source: str, header: str) -> str:
-    """A package 'demo' installed in ``prefix`` (a library and a header, as CMake records them)."""
-    library = _library(build_dir / "objects", library_source)
+def _install(tmp_path: Path, library_source: str, header: str) -> str:
+    """A package 'demo' installed in its own prefix (a library and a header)."""
+    prefix = tmp_path / "install" / "demo"
+    library = _library(tmp_path / "objects", library_source)
     (prefix / "lib").mkdir(parents=True, exist_ok=True)
     (prefix / "include").mkdir(parents=True, exist_ok=True)
     shutil.copy(library, prefix / "lib" / "libdemo.so")
     (prefix / "include" / "demo.h").write_text(header)
-    (build_dir / "install_manifest.txt").write_text(f"{prefix / 'lib' / 'libdemo.so'}\n{prefix / 'include' / 'demo.h'}")
-    return install_interface(build_dir, prefix, "demo")
+    options = BuildOptions(build_base=tmp_path / "build", install_base=tmp_path / "install")
+    return install_interface("demo", tmp_path, options)
 
 
 def test_an_install_counts_libraries_by_interface_and_other_files_by_content(tmp_path: Path) -> None:
-    prefix, build_dir = tmp_path / "install", tmp_path / "build"
     header = "int demo_value(void);\n"
-    first = _install(prefix, build_dir, BASE, header)
-    assert _install(prefix, build_dir, BASE.replace("42", "7"), header) == first
-    assert _install(prefix, build_dir, BASE, header + "/* a comment */\n") != first
-    (prefix / "share" / "demo" / "hook").mkdir(parents=True)
-    (prefix / "share" / "demo" / "hook" / "path.dsv").write_text("prepend-non-duplicate;PATH;bin\n")
-    assert _install(prefix, build_dir, BASE, header) != first  # an environment hook roc wrote
+    first = _install(tmp_path, BASE, header)
+    assert _install(tmp_path, BASE.replace("42", "7"), header) == first
+    assert _install(tmp_path, BASE, header + "/* a comment */\n") != first
+    hooks = tmp_path / "install" / "demo" / "share" / "demo" / "hook"
+    hooks.mkdir(parents=True)
+    (hooks / "path.dsv").write_text("prepend-non-duplicate;PATH;bin\n")
+    assert _install(tmp_path, BASE, header) != first  # an environment hook roc wrote
