@@ -101,9 +101,18 @@ def _has_target(build_dir: Path, target: str) -> bool:
     return False
 
 
-def _check(context: TaskContext, job: PackageJob, command: list[str], what: str) -> None:
-    if context.run(command, cwd=str(job.build_dir), env=job.env, pass_fds=job.pass_fds) != 0:
+def _check(context: TaskContext, job: PackageJob, command: list[str], what: str,
+           env: dict[str, str] | None = None) -> None:
+    if context.run(command, cwd=str(job.build_dir), env=env or job.env, pass_fds=job.pass_fds) != 0:
         raise TaskError(f"{what} failed")
+
+
+def _install_env(env: dict[str, str]) -> dict[str, str]:
+    """CMake's install skips a file whose installed copy has its modification time, which it keeps only
+    to the second: a file rebuilt within the second of the last install would stay uninstalled (and
+    the packages above would build against the old one). CMAKE_INSTALL_ALWAYS copies every file; the
+    copies keep their sources' times, so the makes above see nothing new. A user's own setting wins."""
+    return {"CMAKE_INSTALL_ALWAYS": "1", **env}
 
 
 def build_cmake(context: TaskContext, job: PackageJob, options: BuildOptions) -> None:
@@ -147,7 +156,7 @@ def build_cmake(context: TaskContext, job: PackageJob, options: BuildOptions) ->
     for target in targets:
         _check(context, job, _build_command(job, options, target), f"building target '{target or 'all'}'")
     if not options.cmake_target and _has_target(build_dir, "install"):
-        _check(context, job, ["cmake", "--install", str(build_dir)], "install")
+        _check(context, job, ["cmake", "--install", str(build_dir)], "install", env=_install_env(job.env))
 
 
 def _configure_tools(job: PackageJob, args: list[str]) -> str:
