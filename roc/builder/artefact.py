@@ -68,6 +68,12 @@ def _pattern(paths: list[bytes]) -> re.Pattern[bytes]:
     return re.compile(b"|".join(re.escape(p) for p in sorted(paths, key=len, reverse=True)))
 
 
+def _install_path(install_base: Path) -> re.Pattern[bytes]:
+    """The install base in a path that matters in compiled code: not an installed header's (a dependency's,
+    isolated or merged), which is the ``__FILE__`` of its inline code."""
+    return re.compile(re.escape(str(install_base).encode()) + rb"(?!(?:/[^/\0]+)?/include/)")
+
+
 def installed_files(name: str, places: Places, merged: bool) -> list[Path]:
     """The package's installed files: its whole prefix when isolated; when merged, what its install
     records list, its share/<pkg> directory and its colcon marker."""
@@ -116,7 +122,7 @@ def path_dependent_file(files: list[Path], base: Path, places: Places) -> str | 
     """The first of ``files`` (below ``base``) that holds a path of ``places`` where unpacking cannot
     rewrite it (such a package can only be restored into a workspace at the same place)."""
     everything = _pattern([str(p).encode() for p in places.paths()])
-    installed = _pattern([str(places.install_base).encode()])
+    installed = _install_path(places.install_base)
     for path in files:
         if path.is_file() and not path.is_symlink() and path.suffix != ".pyc":
             if _keeps_path(path, path.read_bytes(), everything, installed):
@@ -127,8 +133,10 @@ def path_dependent_file(files: list[Path], base: Path, places: Places) -> str | 
 def _keeps_path(path: Path, data: bytes, everything: re.Pattern[bytes], installed: re.Pattern[bytes]) -> bool:
     """Whether a path that matters stays in this file after unpacking. In compiled code (ELF files,
     static libraries) only the install path matters: source and build paths there are debug information and assert
-    messages (``__FILE__``), which name where it was built, as in any binary package. Elsewhere every
-    path matters, unless the file is regenerated or a text file of known meaning (rewritten)."""
+    messages (``__FILE__``), which name where it was built, as in any binary package, and so are the paths of
+    installed headers (the logging and asserts of rclcpp's inline code, in every program built on it; no
+    program reads a header when it runs). Elsewhere every path matters, unless the file is regenerated or a
+    text file of known meaning (rewritten)."""
     if _regenerated(path):
         return False
     if data.startswith(COMPILED):
@@ -154,7 +162,7 @@ def _relocate(tree: Path, built_at: Places, places: Places) -> str | None:
     if not replacements:
         return None
     everything = _pattern(list(replacements))
-    installed = _pattern([str(built_at.install_base).encode()])
+    installed = _install_path(built_at.install_base)
     byte_code = []
     for path in sorted(p for p in tree.rglob("*") if p.is_file() and not p.is_symlink()):
         if path.suffix == ".pyc":

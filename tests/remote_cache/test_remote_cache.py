@@ -14,7 +14,7 @@ import shutil
 import threading
 
 import pytest
-from helpers.build import FIXTURES, in_sourced_shell, roc, ros_env
+from helpers.build import FIXTURES, in_sourced_shell, roc, ros_env, without_suite_compiler_cache
 from helpers.remote_servers import free_port, s3, silent_server, webdav
 
 pytestmark = pytest.mark.slow
@@ -54,7 +54,8 @@ def dav(tmp_path_factory):
     netrc.write_text(f"machine 127.0.0.1 login {USER} password {PASSWORD}\n")
     netrc.chmod(0o600)
     with webdav(root, USER, PASSWORD) as port:
-        yield f"http://127.0.0.1:{port}", root, ros_env(NETRC=str(netrc))
+        # no suite-wide ccache: its base directory would make the paths compiled into programs relative
+        yield f"http://127.0.0.1:{port}", root, without_suite_compiler_cache(ros_env(NETRC=str(netrc)))
 
 
 @pytest.fixture(scope="module")

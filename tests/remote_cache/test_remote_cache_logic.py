@@ -231,16 +231,23 @@ def test_which_paths_make_a_package_depend_on_its_place(tmp_path) -> None:
     lib.mkdir(parents=True)
     debug_only = lib / "libdebug.so"
     debug_only.write_bytes(b"\x7fELF\0\0" + str(places.build_base / "pkg" / "gen.c").encode())  # __FILE__
+    header_code = lib / "libheader.so"  # __FILE__ of a dependency's inline code, isolated and merged
+    header_code.write_bytes(b"\x7fELF\0\0" + str(places.install_base / "dep" / "include" / "dep" / "x.hpp").encode()
+                            + b"\0" + str(places.install_base / "include" / "y.hpp").encode())
     archive = lib / "libstatic.a"
     archive.write_bytes(b"!<arch>\n" + str(tmp_path / "src" / "pkg" / "a.c").encode())
     manifest = places.install_base / "pkg" / "share" / "pkg" / "install_manifest.txt"
     manifest.parent.mkdir(parents=True)
     manifest.write_text(str(places.install_base / "pkg" / "lib" / "libdebug.so") + "\n")  # rewritten on unpack
-    files = [debug_only, archive, manifest]
+    files = [debug_only, header_code, archive, manifest]
     assert path_dependent_file(files, places.install_base, places) is None
     rpath = lib / "librpath.so"
     rpath.write_bytes(b"\x7fELF\0\0" + str(lib).encode())  # the install path in a binary: it matters
     assert path_dependent_file([*files, rpath], places.install_base, places) == "pkg/lib/librpath.so"
+    data_path = lib / "libdata.so"  # a path to installed data, beside a header's: it matters
+    data_path.write_bytes(b"\x7fELF\0\0" + str(places.install_base / "dep" / "include" / "x.hpp").encode()
+                          + b"\0" + str(places.install_base / "pkg" / "share" / "pkg" / "include").encode())
+    assert path_dependent_file([*files, data_path], places.install_base, places) == "pkg/lib/libdata.so"
     config = places.install_base / "pkg" / "share" / "pkg" / "where.txt"
     config.write_text(f"sources at {tmp_path / 'src'}\n")  # any path in another text file matters
     assert path_dependent_file([*files, config], places.install_base, places) == "pkg/share/pkg/where.txt"
