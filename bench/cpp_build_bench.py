@@ -27,6 +27,7 @@ the copies an earlier run built and skips the cold phase.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import re
 import resource
@@ -162,11 +163,22 @@ def cluster(env: dict[str, str], runs: int) -> dict[str, float]:
                                    str(workers), *OVERRIDE, *RELEASE]
                         label = f"{workers} worker{'s' if workers > 1 else ''}"
                         results[label].append(timed(ws, command, env, f"roc, {label} (run {run + 1})"))
+                        here = built_here(ws)
+                        if here:  # on the client's cores: the figure would not measure the workers
+                            sys.exit(f"cpp_build_bench: {label}: built on the client, not on the cluster: "
+                                     + "; ".join(here))
                     finally:
                         stop_all(started)
         finally:
             stop_all([scheduler])
     return {label: statistics.median(times) for label, times in results.items()}
+
+
+def built_here(ws: Path) -> list[str]:
+    """The packages a cluster build built on the client instead, and why (its warnings)."""
+    events = [json.loads(line) for line in (ws / "log" / "latest_build" / "events.log").read_text().splitlines()]
+    return [f"{e['task']}: {e['message']}" for e in events
+            if e["event"] == "TaskWarning" and "not on the cluster" in e.get("message", "")]
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -18,7 +18,16 @@ from collections.abc import Iterator
 
 import psutil
 import pytest
-from helpers.build import BIN, FIXTURES, add_cmake_package, in_sourced_shell, installed_files, roc, ros_env
+from helpers.build import (
+    BIN,
+    FIXTURES,
+    add_cmake_package,
+    in_sourced_shell,
+    installed_files,
+    roc,
+    ros_env,
+    without_suite_compiler_cache,
+)
 from helpers.cluster import (
     _wait,
     building,
@@ -71,7 +80,8 @@ def servers(dav, tmp_path_factory):
     """The Dask cluster, shared by the module: (scheduler address, cache URL, environment, worker
     processes by name, worker roots by name)."""
     base = tmp_path_factory.mktemp("servers")
-    env = ros_env()
+    # no suite-wide ccache: its base directory would make the header paths compiled into programs relative
+    env = without_suite_compiler_cache(ros_env())
     with dask_cluster(base, env, {"worker-1": "roc", "worker-2": "dask"}) as cluster:
         address, processes, roots = cluster
         yield address, dav, env, processes, roots
