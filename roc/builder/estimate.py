@@ -15,6 +15,7 @@ from pathlib import Path
 COMPILED = frozenset((".c", ".cc", ".cpp", ".cxx", ".c++"))
 INTERFACES = frozenset((".msg", ".srv", ".action", ".idl", ".proto"))
 SECONDS_EACH = 4.0
+COUNTED = COMPILED | INTERFACES
 AT_LEAST = 1.0  # a package with neither (Python, CMake files alone): the weight of any unknown task
 
 
@@ -22,5 +23,5 @@ def estimated_seconds(source: Path) -> float:
     counted = 0
     for _, directories, files in os.walk(source):
         directories[:] = [d for d in directories if not d.startswith(".")]
-        counted += sum(1 for name in files if os.path.splitext(name)[1] in COMPILED | INTERFACES)
+        counted += sum(1 for name in files if os.path.splitext(name)[1] in COUNTED)
     return max(AT_LEAST, SECONDS_EACH * counted)
