@@ -12,6 +12,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from roc.builder.state import STATE_FILE
+
 COMPILED = frozenset((".c", ".cc", ".cpp", ".cxx", ".c++"))
 INTERFACES = frozenset((".msg", ".srv", ".action", ".idl", ".proto"))
 SECONDS_EACH = 4.0
@@ -25,3 +27,14 @@ def estimated_seconds(source: Path) -> float:
         directories[:] = [d for d in directories if not d.startswith(".")]
         counted += sum(1 for name in files if os.path.splitext(name)[1] in COUNTED)
     return max(AT_LEAST, SECONDS_EACH * counted)
+
+
+def package_weight(recorded: float | None, source: Path, build_dir: Path) -> float:
+    """The scheduler's weight of a package's build: its ``recorded`` duration; the estimate when it was never
+    built here. One restored from a cache has a state but no duration: estimating it would walk its sources
+    on every no-op build, so it weighs as any unknown task."""
+    if recorded is not None:
+        return recorded
+    if (build_dir / STATE_FILE).exists():
+        return AT_LEAST
+    return estimated_seconds(source)

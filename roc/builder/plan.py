@@ -10,7 +10,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from roc.builder.environment import ENVIRONMENT_FILE, build_environment
-from roc.builder.estimate import estimated_seconds
+from roc.builder.estimate import package_weight
 from roc.builder.finish import finish_package
 from roc.builder.interface import install_interface
 from roc.builder.layout import package_prefix
@@ -84,7 +84,7 @@ def plan_build(
             name=package.name,
             dependencies=waits_for,
             action=cluster.action(build) if cluster is not None else build.run,
-            weight=weights[package.name] if package.name in weights else estimated_seconds(build.source),
+            weight=package_weight(weights.get(package.name), build.source, options.build_base / package.name),
             check=build.check,
             restore=build.restore if remote is not None else None,
         ))

@@ -9,7 +9,8 @@ from pathlib import Path
 import pytest
 from helpers.build import add_plain_package, roc
 
-from roc.builder.estimate import AT_LEAST, SECONDS_EACH, estimated_seconds
+from roc.builder.estimate import AT_LEAST, SECONDS_EACH, estimated_seconds, package_weight
+from roc.builder.state import STATE_FILE
 
 
 def test_compiled_sources_and_interface_definitions_count_and_hidden_folders_do_not(tmp_path: Path) -> None:
@@ -22,6 +23,17 @@ def test_compiled_sources_and_interface_definitions_count_and_hidden_folders_do_
 def test_a_package_with_nothing_to_compile_weighs_as_an_unknown_task(tmp_path: Path) -> None:
     (tmp_path / "setup.py").write_text("")
     assert estimated_seconds(tmp_path) == AT_LEAST
+
+
+def test_a_recorded_duration_wins_and_a_package_restored_without_one_is_not_walked(tmp_path: Path) -> None:
+    source, build_dir = tmp_path / "src", tmp_path / "build"
+    source.mkdir()
+    (source / "a.cpp").write_text("")
+    assert package_weight(None, source, build_dir) == SECONDS_EACH
+    assert package_weight(7.5, source, build_dir) == 7.5
+    build_dir.mkdir()
+    (build_dir / STATE_FILE).write_text("{}")  # built elsewhere and restored: no duration recorded here
+    assert package_weight(None, source, build_dir) == AT_LEAST
 
 
 @pytest.mark.slow
