@@ -14,7 +14,6 @@ from typing import Any
 
 from rclpy.qos import QoSProfile
 from rclpy.serialization import deserialize_message
-from unique_identifier_msgs.msg import UUID
 
 from roc.ros.cdr import serialize
 from roc.ros.messages import fill_message, value_to_data
@@ -86,7 +85,8 @@ def goal(graph, params: dict[str, Any]) -> Events:
     while no server is available, then ``accepted {goal_id}`` (or ``rejected``), ``feedback {data}``
     (with ``feedback``), and ``result {data, status}``. Closed before the result, the goal is
     canceled."""
-    from rclpy.action import ActionClient
+    from rclpy.action import ActionClient  # with numpy (unique_identifier_msgs): 0.1 s, for goals only
+    from unique_identifier_msgs.msg import UUID
 
     cls = action_class(params["type"])
     request, plain = _received(params, "goal", cls.Goal), "goal_data" in params

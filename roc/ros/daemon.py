@@ -137,6 +137,9 @@ class Daemon:
 
 
 def main() -> None:
+    from roc.rclpy_guard import guard_rclpy_import
+
+    guard_rclpy_import()  # as every roc process: rclpy loads as the client's did (roc.rclpy_guard)
     path, listener_fd = Path(sys.argv[1]), int(sys.argv[2])
     # stderr is the daemon's log (roc.ros.client.spawn_daemon)
     logging.basicConfig(level=logging.WARNING, format="%(asctime)s %(name)s: %(message)s")

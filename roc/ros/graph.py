@@ -16,11 +16,11 @@ import threading
 import time
 import traceback
 from collections.abc import Callable, Iterator, Mapping, Sequence
+from functools import partial
 from pathlib import Path
 from typing import Any
 
 import rclpy
-from rclpy.action import graph as action_graph
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
@@ -143,6 +143,23 @@ def _service_endpoint(info) -> dict[str, Any]:
     if name:
         endpoint["topic_type"] = f"{package}/{kind}/{name.rstrip('_')}"
     return endpoint
+
+
+# rclpy.action.graph's queries, made as it makes them (Jazzy and Kilted): on the node's handle. Importing
+# rclpy.action loads its client and server, and with them numpy: 0.1 s of every first query.
+def _action_names_and_types(node: Node) -> list[tuple[str, list[str]]]:
+    with node.handle:
+        return node.handle.get_action_names_and_types()
+
+
+def _action_servers(node: Node, name: str, namespace: str) -> list[tuple[str, list[str]]]:
+    with node.handle:
+        return node.handle.get_action_server_names_and_types_by_node(name, namespace)
+
+
+def _action_clients(node: Node, name: str, namespace: str) -> list[tuple[str, list[str]]]:
+    with node.handle:
+        return node.handle.get_action_client_names_and_types_by_node(name, namespace)
 
 
 def _names_and_types(pairs) -> list[dict[str, Any]]:
@@ -406,9 +423,8 @@ class Graph:
         node = self.node
         services = self._others_only(node.get_service_names_and_types(), (node.get_service_names_and_types_by_node,
                                                                           node.get_client_names_and_types_by_node))
-        actions = self._others_only(action_graph.get_action_names_and_types(node), (
-            lambda name, namespace: action_graph.get_action_server_names_and_types_by_node(node, name, namespace),
-            lambda name, namespace: action_graph.get_action_client_names_and_types_by_node(node, name, namespace)))
+        actions = self._others_only(_action_names_and_types(node), (
+            partial(_action_servers, node), partial(_action_clients, node)))
         topics = self._topics()
         if endpoints:
             for topic in topics:
@@ -447,9 +463,9 @@ class Graph:
             "service_servers": _names_and_types(node.get_service_names_and_types_by_node(node_name, namespace)),
             "service_clients": _names_and_types(node.get_client_names_and_types_by_node(node_name, namespace)),
             "action_servers": _names_and_types(
-                action_graph.get_action_server_names_and_types_by_node(node, node_name, namespace)),
+                _action_servers(node, node_name, namespace)),
             "action_clients": _names_and_types(
-                action_graph.get_action_client_names_and_types_by_node(node, node_name, namespace)),
+                _action_clients(node, node_name, namespace)),
         }
 
     def action_info(self, action: str) -> dict[str, Any]:
@@ -457,8 +473,7 @@ class Graph:
         servers: list[dict[str, Any]] = []
         clients: list[dict[str, Any]] = []
         for node_name, namespace in sorted(self._nodes()):
-            for found, query in ((servers, action_graph.get_action_server_names_and_types_by_node),
-                                 (clients, action_graph.get_action_client_names_and_types_by_node)):
+            for found, query in ((servers, _action_servers), (clients, _action_clients)):
                 for name, types in query(self.node, node_name, namespace):
                     if name == action:
                         found.append({"node": full_name(namespace, node_name), "types": list(types)})

@@ -110,6 +110,19 @@ def type_support(msg_type: type) -> int:
     """The address of ``msg_type``'s rosidl_message_type_support_t (imported if it is not yet)."""
     if getattr(msg_type, "_TYPE_SUPPORT", None) is None:
         msg_type.__class__.__import_type_support__()  # type: ignore[attr-defined]
+    return _capsule_pointer(msg_type._TYPE_SUPPORT)  # type: ignore[attr-defined]
+
+
+def package_type_support(package: str, name: str) -> int:
+    """The address of the rosidl_message_type_support_t of ``package``'s message ``name`` as its C type
+    support module names it (``msg__msg__participant_entities_info``): from that module alone, without
+    the message's Python module, which may import numpy (60 ms) for a fixed-size array."""
+    from rosidl_generator_py import import_type_support
+
+    return _capsule_pointer(getattr(import_type_support(package), f"type_support_{name}"))
+
+
+def _capsule_pointer(capsule: object) -> int:
     getter = ctypes.pythonapi.PyCapsule_GetPointer
     getter.restype, getter.argtypes = ctypes.c_void_p, [ctypes.py_object, ctypes.c_char_p]
-    return getter(msg_type._TYPE_SUPPORT, None)  # type: ignore[attr-defined]
+    return getter(capsule, None)

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import array
 import io
-import struct
 from dataclasses import dataclass
 from typing import cast
 
@@ -17,6 +16,7 @@ from rich.style import Style
 from rich.text import Text
 
 from roc.errors import RocError
+from roc.ros.cdr_reader import Reader
 
 IMAGE, COMPRESSED = "sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage"
 TYPES = (IMAGE, COMPRESSED)
@@ -27,35 +27,6 @@ ENCODINGS = {
     "mono8": ("L", "L", 1), "8UC1": ("L", "L", 1),
     "mono16": ("I;16", "I;16", 2), "16UC1": ("I;16", "I;16", 2), "32FC1": ("F", "F;32F", 4),
 }
-
-
-class Reader:
-    """XCDR1 read field by field: each primitive aligned to its size, counted after the encapsulation."""
-
-    def __init__(self, data: bytes) -> None:
-        if len(data) < 4:
-            raise RocError("not a CDR message (fewer than 4 bytes)")
-        self.data, self.offset = data, 4
-        self.order = "<" if data[1] & 1 else ">"
-
-    def number(self, code: str) -> int | float:
-        size = struct.calcsize(code)
-        self.offset += -(self.offset - 4) % size
-        (value,) = struct.unpack_from(self.order + code, self.data, self.offset)
-        self.offset += size
-        return value
-
-    def raw(self) -> bytes:
-        """A string's bytes or a sequence of octets: a uint32 length, then that many bytes."""
-        length = int(self.number("I"))
-        value = self.data[self.offset:self.offset + length]
-        if len(value) < length:
-            raise RocError("the message ends early (a truncated image?)")
-        self.offset += length
-        return value
-
-    def text(self) -> str:
-        return self.raw().rstrip(b"\0").decode(errors="replace")
 
 
 @dataclass
@@ -71,7 +42,7 @@ def picture(type_name: str, cdr: bytes) -> Picture:
     from PIL import Image, UnidentifiedImageError
     from PIL.Image import DecompressionBombError
 
-    reader = Reader(cdr)
+    reader = Reader(cdr, "image")
     reader.number("i"), reader.number("I"), reader.text()  # header: stamp, frame_id
     try:
         if type_name == COMPRESSED:
@@ -82,7 +53,7 @@ def picture(type_name: str, cdr: bytes) -> Picture:
         height, width, encoding = int(reader.number("I")), int(reader.number("I")), reader.text()
         big_endian, step = reader.number("B"), int(reader.number("I"))
         data = reader.raw()
-    except (struct.error, UnidentifiedImageError, DecompressionBombError, OSError) as error:
+    except (UnidentifiedImageError, DecompressionBombError, OSError) as error:
         raise RocError(f"cannot read the image: {error}") from None
     if encoding not in ENCODINGS:
         raise RocError(f"encoding '{encoding}' is not previewed (only {', '.join(ENCODINGS)})")

@@ -20,6 +20,7 @@ from helpers.graph import NODE_SCRIPT, graph_env, read_line, roc, start_nodes, s
 from helpers.rmw import CYCLONEDDS, FASTRTPS, on_middleware, require_cyclonedds, suite_middleware
 
 from roc import distribution
+from roc.errors import RocError
 from roc.middleware import process_environment
 from roc.ros import vendors
 from roc.ros.discovery import (
@@ -465,6 +466,31 @@ def test_a_first_query_hears_processes_that_announce_themselves_once_a_minute(tm
             assert listed.stdout.split() == names, listed.stderr
     finally:
         stop_all(processes)
+
+
+def test_a_discovery_message_is_read_from_its_cdr_as_rclpy_reads_it() -> None:
+    """rclpy's serialization of rmw_dds_common's message is the oracle for roc's reading of its CDR
+    (roc.ros.discovery_info.told_by, which needs neither the message's Python class nor numpy)."""
+    from rclpy.serialization import serialize_message
+    from rmw_dds_common.msg import Gid, NodeEntitiesInfo, ParticipantEntitiesInfo
+
+    from roc.ros.discovery_info import told_by
+
+    def gid(first: int) -> Gid:
+        return Gid(data=list(range(first, first + 16)))
+
+    nodes = [NodeEntitiesInfo(node_namespace="/", node_name="talker", reader_gid_seq=[gid(1)],
+                              writer_gid_seq=[gid(2), gid(3)]),
+             NodeEntitiesInfo(node_namespace="/robot1", node_name="odom_pub", reader_gid_seq=[],
+                              writer_gid_seq=[gid(4)])]
+    cdr = serialize_message(ParticipantEntitiesInfo(gid=gid(100), node_entities_info_seq=nodes))
+    prefix, told = told_by(cdr)
+    assert prefix == bytes(range(100, 112))
+    assert told.nodes == {("/", "talker"), ("/robot1", "odom_pub")}
+    assert told.endpoints == {bytes(range(first, first + 16)) for first in (1, 2, 3, 4)}
+    assert told_by(serialize_message(ParticipantEntitiesInfo(gid=gid(7))))[1] == Told(frozenset(), frozenset())
+    with pytest.raises(RocError, match="ros_discovery_info message ends early"):
+        told_by(cdr[:-5])
 
 
 def _printed_by(script: str, env: dict[str, str]) -> dict:

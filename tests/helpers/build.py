@@ -159,7 +159,7 @@ def package_dsv_files(install: Path) -> dict[str, str]:
 # Each test file that starts ROS participants has a slot of its own; a slot is one ROS domain per
 # pytest-xdist worker, counted from ROC_TEST_DOMAIN_BASE (default 20). Two test runs on one machine (two
 # checkouts, or a person beside a robot on domain 20) stay apart with, e.g., ROC_TEST_DOMAIN_BASE=90.
-DOMAIN_SLOTS = 69
+DOMAIN_SLOTS = 70
 DOMAIN_MAX = 232  # Fast DDS's highest domain id (its UDP ports are derived from it)
 
 
