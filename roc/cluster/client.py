@@ -10,9 +10,11 @@ the same package share one task, named by the package's remote key.
 
 from __future__ import annotations
 
+import contextlib
 import logging
+import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from roc.cluster.spec import PackageWork, WorkResult
@@ -79,6 +81,7 @@ class Cluster:
             raise RocError(f"cannot reach the Dask scheduler at {address}: {reason}") from None
         _quiet_dask_logging()
         self._capacity, self._asked = 0, 0.0
+        self._here, self._here_lock = 0, threading.Lock()
         self.lost = False
         self._names: dict[str, str] = {}  # worker address -> name, as last asked
         self._lost_workers: dict[str, str] = {}  # task key -> the name of the worker lost while running it
@@ -146,15 +149,31 @@ class Cluster:
         return self._capacity
 
     def task_limit(self, local: int) -> int | Callable[[], int]:
-        """The engine's limit of tasks at once (roc.engine.executor.execute's ``workers``): twice what the
-        fitting workers build at once, so that each has its next package waiting while a result travels,
-        and at least ``local`` (--parallel-workers; 0: no limit). The rest stays in roc's ready queue,
-        and what waits on a worker waits in roc's order (each task's priority is the engine's)."""
+        """The engine's limit of tasks at once (roc.engine.executor.execute's ``workers``): what the fitting
+        workers build at once (one while there are none: it waits for the first), and the tasks working
+        on the client (``here``), at most ``local`` of those (--parallel-workers; 0: no limit). Dask gives
+        a task to a worker as it is submitted, so a task submitted beyond the workers' slots waits in one
+        worker's queue: a package of the longest chain, ready a moment later, waited there behind a long
+        build while the other worker was free. Within the limit, what waits stays in roc's ready queue,
+        the longest chain first, and a task keeps its slot while its result is restored here (well under
+        a second), so a package that becomes ready then takes the worker its dependency freed."""
         return local if not local else lambda: self.limit(local)
 
     def limit(self, local: int) -> int:
         """``task_limit``'s value now."""
-        return max(local, 2 * self.capacity())
+        return max(1, self.capacity()) + min(self._here, local)
+
+    @contextlib.contextmanager
+    def here(self) -> Iterator[None]:
+        """While a task of this run works on the client (a package built or tested here, roc.cluster.
+        remote_build and remote_test): it takes none of the workers' slots (``limit``)."""
+        with self._here_lock:
+            self._here += 1
+        try:
+            yield
+        finally:
+            with self._here_lock:
+                self._here -= 1
 
     def run(self, function: Callable[[PackageWork], WorkResult], work: PackageWork, key: str,
             context: TaskContext) -> WorkResult:
@@ -200,8 +219,6 @@ class OnDemand:
     its reason."""
 
     def __init__(self, connect: Callable[[], Cluster]):
-        import threading
-
         self._connect, self._lock = connect, threading.Lock()
         self._cluster: Cluster | None = None
         self._failed: str | None = None
@@ -229,6 +246,10 @@ class OnDemand:
     def task_limit(self, local: int) -> int | Callable[[], int]:
         """Cluster.task_limit once connected; ``local`` until then."""
         return local if not local else lambda: self._cluster.limit(local) if self._cluster is not None else local
+
+    def here(self) -> contextlib.AbstractContextManager:
+        """Cluster.here once connected; nothing to count until then (the limit is ``local``)."""
+        return self._cluster.here() if self._cluster is not None else contextlib.nullcontext()
 
     def close(self) -> None:
         if self._cluster is not None:

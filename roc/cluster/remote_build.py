@@ -66,7 +66,8 @@ class ClusterBuilds:
     def _here(self, build: _PackageBuild, context: TaskContext, why: str) -> None:
         self.here[build.package.name] = why
         context.emit(TaskWarning(context.name, context.kind, message=f"built here, not on the cluster: {why}"))
-        build.run(context)
+        with self.cluster.here():  # on the client's cores, beside the workers' slots
+            build.run(context)
 
     def _stays_here(self, build: _PackageBuild) -> str | None:
         options = build.options

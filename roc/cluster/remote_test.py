@@ -47,7 +47,8 @@ class ClusterTests:
             context.emit(TaskWarning(context.name, context.kind, message=(
                 f"tested here, not on the cluster: {without[0]} has no remote key (build with --remote-cache or "
                 "--cluster first)")))
-            return test.run_here(context), None
+            with self.cluster.here():  # on the client's cores, beside the workers' slots
+                return test.run_here(context), None
         work = self._work(test, keys)
         result = self.cluster.run(on_worker.test, work, f"roc-test-{work.key}-{uuid.uuid4().hex[:8]}", context)
         for event in result.events:

@@ -149,6 +149,28 @@ def test_the_limit_may_change_while_running():
     assert most[0] == 3
 
 
+def test_the_cluster_gets_as_many_packages_at_once_as_its_workers_build(monkeypatch):
+    """Dask gives a task to a worker as it is submitted, so one beyond the workers' slots would wait in a
+    worker's queue, where a package of the longest chain ready later waited behind a long build while
+    the other worker was free: the engine's limit is the fitting workers' slots (one while there are
+    none), and besides them the tasks working on the client, at most --parallel-workers of those. No
+    scheduler here: Cluster's arithmetic on the workers it is told of."""
+    from roc.cluster.client import Cluster
+
+    cluster = Cluster.__new__(Cluster)
+    cluster._capacity, cluster._asked, cluster.lost = 0, 0.0, False
+    cluster._here, cluster._here_lock = 0, threading.Lock()
+    workers: dict[str, float] = {}
+    monkeypatch.setattr(cluster, "fitting", lambda: workers)
+    assert cluster.limit(8) == 1  # no worker yet: one task waits for the first
+    workers.update({"worker-0": 1.0, "worker-1": 2.0})
+    cluster._asked = -1.0  # ask the scheduler again
+    assert cluster.limit(8) == 3
+    with cluster.here(), cluster.here():
+        assert [cluster.limit(local) for local in (1, 8)] == [4, 5]
+    assert cluster.limit(8) == 3
+
+
 def test_console_and_board_show_the_worker():
     out = io.StringIO()
     console = ConsoleHandler(out, status=None)
