@@ -5,7 +5,7 @@ query of a session (no daemon running: each tool starts its own) with its comple
 
     python bench/graph_bench.py [--runs 10] [--no-daemon-runs 3] [--completeness-runs 20]
                                 [--cold-runs 20] [--range LOCALHOST] [--only cold]
-                                [--middlewares fastdds,cyclonedds,mixed]
+                                [--middlewares fastdds,cyclonedds,mixed,cyclonedds-beside-fastdds]
 
 The graph is the demo graph of the tests (tests/helpers/graph.py: six nodes in three processes) in
 ROS domain 90 with localhost discovery; roc's daemon gets a private runtime directory. The ros2 CLI
@@ -36,6 +36,8 @@ graph of its own, then a summary that puts them side by side.
   wheels' bootstrapper would set that path, and without it Python does not start (exit 127).
 - ``mixed``: the graph, roc and ros2 on Fast DDS, and beside them one Cyclone DDS process on the same
   domain (a talker on /chatter). Target: its cold first query no slower than fastdds's.
+- ``cyclonedds-beside-fastdds``: the graph on Fast DDS, roc and ros2 on Cyclone DDS. Target: its cold
+  first query no slower than cyclonedds's (the summary's ``cyclonedds-beside-fastdds/cyclonedds``).
 Targets: on Cyclone, cold roc at most ros2's cold time on Cyclone and complete N of N; warm roc verbs at
 most 1.1x the same verbs on Fast DDS (the summary's ``roc cyclonedds/fastdds``).
 """
@@ -71,10 +73,12 @@ COMMANDS = [("topic", "list"), ("topic", "info", "-v", "/chatter"), ("node", "li
             ("param", "get", "/motor_controller", "max_speed")]
 COLD_COMMANDS = [("node", "list"), ("topic", "list"), ("service", "list")]
 NODES = ["/fibonacci_server", "/listener", "/map_server", "/motor_controller", "/robot1/odom_pub", "/talker"]
-# the set-ups of --middlewares: the middleware of the graph's nodes and of both tools, and the nodes of
-# Cyclone DDS processes beside them
+# the set-ups of --middlewares: the middleware of the graph's nodes, that of both tools, and the nodes of
+# Cyclone DDS processes beside them; and the set-up each is measured against in the summary
 CYCLONE_TALKER = [{"name": "cyclone_talker", "publishers": [{"topic": "chatter", "type": "std_msgs/msg/String"}]}]
-SETUPS = {"fastdds": (FASTRTPS, []), "cyclonedds": (CYCLONEDDS, []), "mixed": (FASTRTPS, [CYCLONE_TALKER])}
+SETUPS = {"fastdds": (FASTRTPS, FASTRTPS, []), "cyclonedds": (CYCLONEDDS, CYCLONEDDS, []),
+          "mixed": (FASTRTPS, FASTRTPS, [CYCLONE_TALKER]), "cyclonedds-beside-fastdds": (FASTRTPS, CYCLONEDDS, [])}
+AGAINST = {"cyclonedds-beside-fastdds": "cyclonedds"}  # the others: against fastdds
 
 
 def booted(env: dict[str, str], venv: Path) -> dict[str, str]:
@@ -124,26 +128,26 @@ def timed(name: str, args: tuple[str, ...], env: dict[str, str], boot: bool = Tr
 
 @contextlib.contextmanager
 def live_graph(domain: int, specs: list, discovery_range: str = "LOCALHOST", middleware: str = FASTRTPS,
-               cyclone_specs: list = ()):
+               cyclone_specs: list = (), tools_middleware: str | None = None):
     """The ros2 oracle installed, the nodes of ``specs`` running in ROS domain ``domain`` with this
     discovery range on ``middleware`` (those of ``cyclone_specs`` on Cyclone DDS), both tools' daemons
     started and given a discovery period; everything stopped afterwards. Yields the tools' environment
-    (on ``middleware``) and a fresh work directory."""
+    (on ``tools_middleware``, by default ``middleware``) and a fresh work directory."""
     reason = install_oracle()
     if reason:
         raise SystemExit(f"the ros2 CLI is not available: {reason}")
-    if (middleware == CYCLONEDDS or cyclone_specs) and not (STACK / "ready").is_file():
+    if (CYCLONEDDS in (middleware, tools_middleware) or cyclone_specs) and not (STACK / "ready").is_file():
         raise SystemExit(MISSING)
     with tempfile.TemporaryDirectory(prefix="roc-bench-") as directory:
         work = Path(directory)
         env = graph_env(0, work)  # then its own domain, outside the tests
         env["ROS_DOMAIN_ID"] = str(domain)
         env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = discovery_range
-        env = on_middleware(env, middleware)
         processes = []
         try:
-            processes += start_nodes(specs, env)
+            processes += start_nodes(specs, on_middleware(env, middleware))
             processes += start_nodes(list(cyclone_specs), on_middleware(env, CYCLONEDDS))
+            env = on_middleware(env, tools_middleware or middleware)
             for name in ("roc", "ros2"):
                 subprocess.run([tool(name), "daemon", "start"], env=tool_process_env(name, env), capture_output=True,
                                timeout=60)
@@ -204,10 +208,10 @@ def cold(env: dict[str, str], runs: int, extra: tuple[str, ...]) -> list[tuple]:
 def run_setup(setup: str, options: argparse.Namespace) -> dict[str, list[tuple]]:
     """The warm and no-daemon rows, the completeness counts and the cold rows of one set-up of SETUPS,
     printed as they come."""
-    middleware, cyclone_specs = SETUPS[setup]
+    middleware, tools_middleware, cyclone_specs = SETUPS[setup]
     results: dict[str, list[tuple]] = {"warm": [], "complete": [], "cold": []}
     nodes = sorted([*NODES, *(f"/{node['name']}" for spec in cyclone_specs for node in spec)])
-    with live_graph(90, DEMO_GRAPH, options.range, middleware, cyclone_specs) as (env, _):
+    with live_graph(90, DEMO_GRAPH, options.range, middleware, cyclone_specs, tools_middleware) as (env, _):
         for name in ("roc", "ros2"):  # warm-up
             timed(name, ("topic", "list"), env)
         print(f"\nmiddlewares {setup}, discovery range {options.range}")
@@ -239,7 +243,8 @@ def run_setup(setup: str, options: argparse.Namespace) -> dict[str, list[tuple]]
 
 def summary(results: dict[str, dict[str, list[tuple]]]) -> None:
     """The set-ups side by side: per command, roc's and ros2's medians on each, and roc's time on each
-    against its time on fastdds (cyclonedds/fastdds: the warm target; mixed/fastdds: the cold one)."""
+    against its time on fastdds (cyclonedds/fastdds: the warm target; mixed/fastdds: the cold one), or on
+    the set-up AGAINST names (cyclonedds-beside-fastdds/cyclonedds: the cold target)."""
     setups = list(results)
     for part, title in (("warm", "warm and no daemon"), ("cold", "first query (no daemon running)")):
         rows = {setup: {row[0]: row for row in results[setup][part]} for setup in setups}
@@ -256,8 +261,9 @@ def summary(results: dict[str, dict[str, list[tuple]]]) -> None:
                     continue
                 cell = f"{setup} {row[1]:.3f}/{row[2]:.3f} ({row[1] / row[2]:.2f}"
                 cells.append(cell + (f", {row[3]}, {row[4]})" if part == "cold" else ")"))
-                if setup != "fastdds" and command in rows.get("fastdds", {}):
-                    cells[-1] += f" {setup}/fastdds {row[1] / rows['fastdds'][command][1]:.2f}"
+                against = AGAINST.get(setup, "fastdds")
+                if setup != against and command in rows.get(against, {}):
+                    cells[-1] += f" {setup}/{against} {row[1] / rows[against][command][1]:.2f}"
             print(f"  {command:42} " + "  ".join(cells))
 
 

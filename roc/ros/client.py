@@ -350,8 +350,12 @@ class Session:
             self._first = start_daemon() if long_lived else running_daemon()
             if self._first is not None:
                 return
+        # fetching what this process's participant needs from the others while rclpy loads (early_probe);
         # a one-shot verb's participant only asks; a long-lived one's streams may publish (the TUI's)
-        self.graph = _in_process().discovered_graph(spin_time, asks_only=not long_lived)
+        from roc.ros.discovery import early_probe
+
+        probe = early_probe()
+        self.graph = _in_process().discovered_graph(spin_time, asks_only=not long_lived, probe=probe)
         self.start_daemon_on_close = use_daemon
 
     def query(self, method: str, params: dict[str, Any] | None = None) -> Any:

@@ -31,6 +31,10 @@ would hear a Fast DDS participant's endpoints and ``ros_discovery_info`` only at
 periodic HEARTBEAT (roc.ros.vendors.cyclonedds): the probe prompts them, by the GUID prefixes and
 locators they answered with, to send one at once (``writers_to_prompt``, ``LocalParticipantProbe.prompt``).
 
+A Fast DDS writer of endpoint announcements answers a request 0.1 s after it comes, so a query without
+the daemon asks them before its participant exists, while rclpy loads, and passes what they send on to
+that participant (``early_probe``, roc.ros.endpoint_fetch).
+
 Participants on other hosts (a discovery range beyond this host) cannot be counted: the caller waits
 for the graph to go quiet for them. This module reads /proc and rclpy endpoint infos and sends UDP
 datagrams; it never imports rclpy itself (``roc tui`` finds each node's process with it too).
@@ -47,11 +51,16 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from roc.ros.protocol import is_own_node
+from roc.ros import vendors
+from roc.ros.endpoint_fetch import EndpointFetch
+from roc.ros.protocol import is_own_node, middleware
 from roc.ros.spdp import (
+    GUID_PREFIX_BYTES,
     PID_DEFAULT_UNICAST_LOCATOR,
+    RTPS_HEADER_BYTES,
     SEDP_PUBLICATIONS,
     SEDP_SUBSCRIPTIONS,
+    SPDP_WRITER,
     acknack_prompt,
     announced_locators,
     announced_properties,
@@ -69,11 +78,10 @@ UNKNOWN_NODE = "_NODE_NAME_UNKNOWN_"  # rmw_dds_common's name for the node of an
 MAX_PARTICIPANT_ID = 119  # the highest id whose ports stay within the domain's 250
 DISCOVERY_TOPIC = "ros_discovery_info"  # a DDS name, outside ROS's conventions (no rt/ prefix)
 UDP_TABLES = (Path("/proc/net/udp"), Path("/proc/net/udp6"))
-GUID_PREFIX_BYTES = 12
 ENTITY_ID = slice(GUID_PREFIX_BYTES, GUID_PREFIX_BYTES + 4)  # of a GUID (an endpoint GID): after its prefix
-RTPS_HEADER_BYTES = 20  # "RTPS", version, vendor id, then the sender's GUID prefix (RTPS 8.3.3.1)
 ASK_AGAIN_SECONDS = 0.5  # LocalParticipantProbe.ask_again: at most this often
 PROMPT_AGAIN_SECONDS = 0.2  # LocalParticipantProbe.prompt: the same prompt to a participant at most this often
+EARLY_ANSWER_SECONDS = 0.02  # early_probe: at most this long for the participants' answers and HEARTBEATs
 INPUT_BUFFER_BYTES = 4 * 1024 * 1024  # what a participant's discovery socket asks for (enlarge_input_buffers)
 
 
@@ -149,10 +157,11 @@ def _peer_addresses(sockets: list[tuple[str | None, int, bool]], own: bool) -> l
     return sorted({(_reachable(address), port) for address, port, ours in sockets if ours == own and address})
 
 
-def _send_stand_in(domain_id: int, locators: list[tuple[str, int]], peers: list[tuple[str, int]]) -> int:
+def _send_stand_in(domain_id: int, locators: list[tuple[str, int]], peers: list[tuple[str, int]],
+                   prefix: bytes | None = None, fetches_endpoints: bool = False) -> int:
     """Send each of ``peers`` the announcement of a stand-in participant of ``domain_id`` whose locators
-    are ``locators``; returns to how many it went."""
-    message = stand_in_announcement(domain_id, locators)
+    are ``locators`` (roc.ros.spdp.stand_in_announcement); returns to how many it went."""
+    message = stand_in_announcement(domain_id, locators, prefix, fetches_endpoints)
     asked = 0
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
         for peer in peers:
@@ -188,14 +197,23 @@ class LocalParticipantProbe:
     stand-in (Cyclone DDS's) goes on, undirected, to this process's participants in the domain
     (roc.ros.spdp.undirected: a Fast DDS participant beside a Cyclone one otherwise heard it up to 1 s
     later, in 1 to 5 of 8 first queries here). ``prompt`` asks the writers of a participant that answered
-    for a HEARTBEAT, at the locators of its answer."""
+    for a HEARTBEAT, at the locators of its answer.
 
-    def __init__(self, domain_id: int, tables: tuple[Path, ...] = UDP_TABLES) -> None:
+    ``fetches_endpoints``: its first stand-in also reads endpoint announcements, so every participant
+    offers it its endpoints, and the probe asks each writer of them whose vendor answers such a request
+    late (Fast DDS: 0.1 s after it comes, roc.ros.vendors.fastdds) for all its HEARTBEAT says it has
+    (EndpointFetch); a writer that answers at once gets an acknowledgement of all it has instead.
+    Made before this process's participant (early_probe), it has their announcements by the time that
+    participant exists, and ``pass_on_endpoints`` gives the messages to it whole: they come from their
+    writer, to a reader that knows that writer, and each participant takes them as if sent to it. A
+    first query of a Cyclone DDS participant beside three Fast DDS processes took 0.36 s with it and
+    0.45 s without (12 runs each), beside three Cyclone DDS processes 0.35 s either way."""
+
+    def __init__(self, domain_id: int, tables: tuple[Path, ...] = UDP_TABLES, fetches_endpoints: bool = False) -> None:
         self.domain_id = domain_id
         self.tables = tables
         self._socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self._socket.bind(("127.0.0.1", 0))
-        self._socket.setblocking(False)
         self._heard: dict[bytes, dict[str, str]] = {}  # GUID prefix -> the properties it announced
         self._asked_at: float | None = None
         self._ours: list[tuple[str, int]] = []  # this process's participants' discovery ports
@@ -203,6 +221,12 @@ class LocalParticipantProbe:
         self._locators: dict[bytes, tuple[list[tuple[str, int]], list[tuple[str, int]]]] = {}
         # (GUID prefix, the endpoints prompted) -> when (prompt)
         self._prompted_at: dict[tuple[bytes, tuple[tuple[bytes, bytes], ...]], float] = {}
+        self._fetcher = EndpointFetch() if fetches_endpoints else None
+        self._asked = 0  # participants the last ask went to
+        if self._fetcher is not None:  # what they send waits here while rclpy loads
+            with contextlib.suppress(OSError):
+                self._socket.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, INPUT_BUFFER_BYTES)
+        self._socket.setblocking(False)
 
     def ask(self) -> int:
         """Ask every participant of another process on this host to announce itself to the probe; returns
@@ -213,7 +237,15 @@ class LocalParticipantProbe:
         except (OSError, IndexError, ValueError):
             return 0
         peers, self._ours = _peer_addresses(sockets, own=False), _peer_addresses(sockets, own=True)
-        return _send_stand_in(self.domain_id, [self._socket.getsockname()], peers) if peers else 0
+        if not peers:
+            return 0
+        prefix = os.urandom(GUID_PREFIX_BYTES)
+        fetcher = self._fetcher if self._fetcher is not None and not self._fetcher.stand_ins else None
+        if fetcher is not None:  # the first stand-in only: a later one would be offered it all again
+            fetcher.stand_ins.add(prefix)
+        self._asked = _send_stand_in(self.domain_id, [self._socket.getsockname()], peers, prefix,
+                                     fetcher is not None)
+        return self._asked
 
     def ask_again(self) -> int:
         """``ask`` if the last was ASK_AGAIN_SECONDS ago or more (else 0)."""
@@ -230,17 +262,40 @@ class LocalParticipantProbe:
         announced_properties: Cyclone DDS names its host and process there), by GUID prefix."""
         while True:
             try:
-                message = self._socket.recv(65536)
+                self._take(self._socket.recv(65536))
             except (BlockingIOError, InterruptedError):
                 return dict(self._heard)
-            if message.startswith(b"RTPS") and len(message) >= RTPS_HEADER_BYTES:
-                prefix = message[8:RTPS_HEADER_BYTES]
-                if prefix not in self._heard:
-                    self._pass_on(message)
-                self._heard[prefix] = announced_properties(message) or self._heard.get(prefix, {})
-                locators = (announced_locators(message), announced_locators(message, PID_DEFAULT_UNICAST_LOCATOR))
-                if any(locators):
-                    self._locators[prefix] = locators
+
+    def answer_heartbeats(self, seconds: float) -> None:
+        """Take what comes for at most ``seconds``, until every participant asked has answered and has
+        been asked for its endpoints (a fetching probe): what they send later waits in the socket's
+        buffer, taken by ``announced`` and ``pass_on_endpoints``. No thread of its own: one taking each
+        message while rclpy loads held Python's lock so often that the participant came 60 ms later."""
+        if self._fetcher is None:
+            return
+        deadline = time.monotonic() + seconds
+        try:
+            while not self._fetcher.asked_all(self._asked) and (left := deadline - time.monotonic()) > 0:
+                self._socket.settimeout(left)
+                with contextlib.suppress(TimeoutError, InterruptedError):
+                    self._take(self._socket.recv(65536))
+        finally:
+            self._socket.setblocking(False)
+
+    def _take(self, message: bytes) -> None:
+        if not message.startswith(b"RTPS") or len(message) < RTPS_HEADER_BYTES:
+            return
+        prefix = message[8:RTPS_HEADER_BYTES]
+        if SPDP_WRITER in message:  # an announcement: a participant's answer (a fetching probe gets more)
+            if prefix not in self._heard:
+                self._pass_on(message)
+            self._heard[prefix] = announced_properties(message) or self._heard.get(prefix, {})
+            locators = (announced_locators(message), announced_locators(message, PID_DEFAULT_UNICAST_LOCATOR))
+            if any(locators):
+                self._locators[prefix] = locators
+        if self._fetcher is not None:
+            for request, address in self._fetcher.take(prefix, message, self._locators.get(prefix, ([], []))[0]):
+                self._send(request, address)
 
     def _pass_on(self, answer: bytes) -> None:
         """Send an answer directed to the stand-in, undirected, to this process's participants."""
@@ -248,10 +303,29 @@ class LocalParticipantProbe:
         if message is None:  # no INFO_DST: nothing to pass on (roc.ros.spdp.undirected)
             return
         for address in self._ours:
-            try:
-                self._socket.sendto(message, address)
-            except OSError:  # gone meanwhile, or a full buffer: that peer is heard at its next announcement
-                continue
+            self._send(message, address)
+
+    def pass_on_endpoints(self) -> int:
+        """Send this process's participants the endpoint announcements fetched so far, each a few times
+        (roc.ros.endpoint_fetch.PASS_ON_TIMES: one that comes before a participant has taken in its
+        writer's participant is dropped); returns how many messages went."""
+        if self._fetcher is None:
+            return 0
+        if not self._ours:  # asked before this process had a participant
+            with contextlib.suppress(OSError, IndexError, ValueError):
+                self._ours = _peer_addresses(metatraffic_sockets(self.domain_id, self.tables), own=True)
+        self.announced()  # what came meanwhile
+        messages = self._fetcher.to_pass_on() if self._ours else []
+        for message in messages:
+            for address in self._ours:
+                self._send(message, address)
+        return len(messages)
+
+    def _send(self, message: bytes, address: tuple[str, int]) -> None:
+        try:
+            self._socket.sendto(message, (_reachable(address[0]), address[1]))
+        except OSError:  # gone meanwhile, or a full buffer: heard, or asked for, again later
+            pass
 
     def prompt(self, reader_prefix: bytes, writer_prefix: bytes, endpoints: list[tuple[bytes, bytes]],
                count: int) -> bool:
@@ -261,24 +335,33 @@ class LocalParticipantProbe:
         it announced, the others at its default ones, where it takes each (roc.ros.vendors.fastdds).
         Not when it was sent the same in the last PROMPT_AGAIN_SECONDS; returns whether they went."""
         now, key = time.monotonic(), (writer_prefix, tuple(endpoints))
-        if writer_prefix not in self._locators or \
-                now - self._prompted_at.get(key, -PROMPT_AGAIN_SECONDS) < PROMPT_AGAIN_SECONDS:
+        locators = self._locators.get(writer_prefix)
+        if locators is None or now - self._prompted_at.get(key, -PROMPT_AGAIN_SECONDS) < PROMPT_AGAIN_SECONDS:
             return False
         self._prompted_at[key] = now
-        for locators, builtin in zip(self._locators[writer_prefix], (True, False)):
+        for addresses, builtin in zip(locators, (True, False)):
             chosen = [pair for pair in endpoints if is_builtin(pair[1]) == builtin]
-            if not chosen:
-                continue
-            message = acknack_prompt(reader_prefix, writer_prefix, chosen, count)
-            for address, port in locators:
-                try:
-                    self._socket.sendto(message, (_reachable(address), port))
-                except OSError:  # gone meanwhile, or a full buffer: prompted again on the next call
-                    continue
+            if chosen:
+                message = acknack_prompt(reader_prefix, writer_prefix, chosen, count)
+                for address in addresses:
+                    self._send(message, address)
         return True
 
     def close(self) -> None:
         self._socket.close()
+
+
+def early_probe(environment: Mapping[str, str] = os.environ) -> LocalParticipantProbe | None:
+    """A probe of this process's ROS domain that fetches endpoint announcements, asked now: made before
+    this process's participant, while rclpy loads (LocalParticipantProbe, ``fetches_endpoints``). None on
+    a middleware without RTPS, or where the domain id is no number (rcl then says what is wrong)."""
+    domain = environment.get("ROS_DOMAIN_ID", "").strip() or "0"
+    if not domain.isdigit() or not vendors.speaks_rtps(middleware(environment)):
+        return None
+    probe = LocalParticipantProbe(int(domain), fetches_endpoints=True)
+    probe.ask()
+    probe.answer_heartbeats(EARLY_ANSWER_SECONDS)
+    return probe
 
 
 def enlarge_input_buffers(domain_id: int, size: int = INPUT_BUFFER_BYTES) -> int:

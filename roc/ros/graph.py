@@ -267,21 +267,25 @@ class Graph:
                       for n, t in sorted(node.get_topic_names_and_types())),
                 tuple((n, tuple(t)) for n, t in sorted(node.get_service_names_and_types())))
 
-    def wait_for_discovery(self, period: float | None = None) -> str:
+    def wait_for_discovery(self, period: float | None = None, probe: LocalParticipantProbe | None = None) -> str:
         """Return once this host's participants are discovered, every participant discovered is wholly
         known (see _complete) and the graph has been unchanged for a quiet time (see QUIET_SECONDS); at
         the latest after ``period``. Without one, after DEFAULT_SPIN_TIME, or, while the graph is known
         to be incomplete (a participant of this host not heard yet, a node or endpoint it told not
         discovered yet), what this process's DDS vendor may need more for a participant it heard only at
         its next periodic announcement (roc.ros.vendors: one more announcement period on Fast DDS, on a
-        loaded machine). Returns why it ended: COMPLETE, PERIOD_ENDED or INCOMPLETE."""
+        loaded machine). Returns why it ended: COMPLETE, PERIOD_ENDED or INCOMPLETE.
+
+        ``probe``: the domain's probe, made before this participant (roc.ros.discovery.early_probe), whose
+        fetched endpoint announcements it passes on; this closes it. By default, one made now."""
         quiet = LOCAL_QUIET_SECONDS if discovery_stays_local() else QUIET_SECONDS
         bound = DEFAULT_SPIN_TIME if period is None else period
         vendor = vendors.of_middleware(middleware())
         longest = bound + (vendor.late_answer_seconds if vendor else 0.0) if period is None else period
         domain = self.context.get_domain_id()
         reader = DiscoveryInfoReader(self.node)
-        probe = LocalParticipantProbe(domain) if vendors.speaks_rtps(middleware()) else None
+        if probe is None and vendors.speaks_rtps(middleware()):
+            probe = LocalParticipantProbe(domain)
         prompter = probe if vendor is not None and vendor.loses_early_heartbeats else None
         try:
             start = last_change = time.monotonic()
@@ -290,6 +294,8 @@ class Graph:
             last, prompting = self.signature(), prompter is not None
             while True:
                 soon = prompting and time.monotonic() - start < PROMPT_POLL_LIMIT
+                if probe is not None:
+                    probe.pass_on_endpoints()
                 time.sleep(PROMPT_POLL_SECONDS if soon else POLL_SECONDS)
                 now = time.monotonic()
                 current = self.signature()

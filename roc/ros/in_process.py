@@ -6,17 +6,24 @@ from __future__ import annotations
 
 from typing import Any
 
+from roc.ros.discovery import LocalParticipantProbe
 from roc.ros.graph import Graph
 from roc.ros.protocol import Events
 from roc.ros.streams import run_on
 
 
-def discovered_graph(spin_time: float | None = None, node_name: str | None = None, asks_only: bool = False) -> Graph:
+def discovered_graph(spin_time: float | None = None, node_name: str | None = None, asks_only: bool = False,
+                     probe: LocalParticipantProbe | None = None) -> Graph:
     """A fresh participant that has waited for discovery (at most ``spin_time``; see
-    Graph.wait_for_discovery for the default); ``asks_only``: see Graph."""
-    graph = Graph(node_name, asks_only=asks_only)
+    Graph.wait_for_discovery for the default and ``probe``, which this closes); ``asks_only``: see Graph."""
     try:
-        graph.wait_for_discovery(spin_time)
+        graph = Graph(node_name, asks_only=asks_only)
+    except BaseException:
+        if probe is not None:
+            probe.close()
+        raise
+    try:
+        graph.wait_for_discovery(spin_time, probe)
     except BaseException:
         graph.close()
         raise

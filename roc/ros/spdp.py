@@ -46,9 +46,15 @@ PID_PARTICIPANT_GUID = 0x0050
 PID_BUILTIN_ENDPOINT_SET = 0x0058
 PID_PROPERTY_LIST = 0x0059
 FLAG_LITTLE_ENDIAN, FLAG_INLINE_QOS = 0x01, 0x02
-PARTICIPANT_ANNOUNCER_AND_DETECTOR = 0x3  # the only builtin endpoints the stand-in has
+PARTICIPANT_ANNOUNCER_AND_DETECTOR = 0x3  # the builtin endpoints every stand-in has
+ENDPOINT_DETECTORS = 0x8 | 0x20  # a fetching stand-in's readers of endpoint announcements (publications, subscriptions)
+MAX_REQUESTED = 256  # sequence numbers one ACKNACK can ask for (RTPS 9.4.2.6: a SequenceNumberSet's bitmap)
 SUBMESSAGE_ACKNACK = 0x06
+SUBMESSAGE_HEARTBEAT = 0x07
+SUBMESSAGE_DATA_FRAG = 0x16
 SUBMESSAGE_INFO_DST = 0x0E  # what follows in the message is for the participant it names only (RTPS 8.3.7.7)
+RTPS_HEADER_BYTES = 20  # "RTPS", version, vendor id, then the sender's GUID prefix (RTPS 8.3.3.1)
+GUID_PREFIX_BYTES = 12
 ZERO_LENGTH_SUBMESSAGES = (0x01, 0x09)  # PAD and INFO_TS: a length of 0 is theirs; any other's runs to the end
 LEASE_SECONDS = 1
 # the endpoint discovery (SEDP) endpoints every participant has (RTPS 9.3.1.3): (reader, writer) entity ids
@@ -65,11 +71,14 @@ def _udp_locator(address: str, port: int) -> bytes:
     return struct.pack("<iI", LOCATOR_KIND_UDPV4, port) + bytes(12) + ipaddress.IPv4Address(address).packed
 
 
-def stand_in_announcement(domain_id: int, locators: list[tuple[str, int]]) -> bytes:
-    """One RTPS message: the announcement of a stand-in participant (a random GUID prefix: new to every
-    participant each time) in ``domain_id`` whose metatraffic and default unicast locators are
-    ``locators`` (IPv4 address, UDP port)."""
-    prefix = os.urandom(12)
+def stand_in_announcement(domain_id: int, locators: list[tuple[str, int]], prefix: bytes | None = None,
+                          fetches_endpoints: bool = False) -> bytes:
+    """One RTPS message: the announcement of a stand-in participant in ``domain_id`` whose metatraffic and
+    default unicast locators are ``locators`` (IPv4 address, UDP port), with GUID prefix ``prefix``
+    (by default a random one: new to every participant each time); ``fetches_endpoints``: it also has
+    the readers of endpoint announcements, so every participant offers it its endpoints."""
+    prefix = prefix or os.urandom(12)
+    builtin = PARTICIPANT_ANNOUNCER_AND_DETECTOR | (ENDPOINT_DETECTORS if fetches_endpoints else 0)
     parameters = [
         _parameter(PID_PROTOCOL_VERSION, PROTOCOL_VERSION),
         _parameter(PID_VENDORID, VENDOR_UNKNOWN),
@@ -78,7 +87,7 @@ def stand_in_announcement(domain_id: int, locators: list[tuple[str, int]]) -> by
         *(_parameter(pid, _udp_locator(address, port)) for address, port in locators
           for pid in (PID_METATRAFFIC_UNICAST_LOCATOR, PID_DEFAULT_UNICAST_LOCATOR)),
         _parameter(PID_PARTICIPANT_LEASE_DURATION, struct.pack("<iI", LEASE_SECONDS, 0)),
-        _parameter(PID_BUILTIN_ENDPOINT_SET, struct.pack("<I", PARTICIPANT_ANNOUNCER_AND_DETECTOR)),
+        _parameter(PID_BUILTIN_ENDPOINT_SET, struct.pack("<I", builtin)),
         struct.pack("<HH", PID_SENTINEL, 0),
     ]
     sequence_number = struct.pack("<iI", 0, 1)
@@ -185,20 +194,63 @@ def undirected(message: bytes) -> bytes | None:
     passes it on)."""
     if not message.startswith(b"RTPS"):
         return None
-    kept, offset, directed = [message[:20]], 20, False
+    kept, directed = [message[:RTPS_HEADER_BYTES]], False
     try:
-        while offset + 4 <= len(message):
-            kind, flags = message[offset], message[offset + 1]
-            (length,) = struct.unpack_from("<H" if flags & FLAG_LITTLE_ENDIAN else ">H", message, offset + 2)
-            end = len(message) if length == 0 and kind not in ZERO_LENGTH_SUBMESSAGES else offset + 4 + length
+        for kind, _, start, end in _submessages(message):
             if kind == SUBMESSAGE_INFO_DST:
                 directed = True
             else:
-                kept.append(message[offset:end])
-            offset = end
+                kept.append(message[start:end])
     except struct.error:
         return None
     return b"".join(kept) if directed else None
+
+
+def _submessages(message: bytes) -> Iterator[tuple[int, str, int, int]]:
+    """Each submessage of an RTPS message: its kind, byte order ("<" or ">") and where it starts (at its
+    header) and ends. Raises struct.error on a message cut short."""
+    offset = RTPS_HEADER_BYTES
+    while offset + 4 <= len(message):
+        kind, flags = message[offset], message[offset + 1]
+        order = "<" if flags & FLAG_LITTLE_ENDIAN else ">"
+        (length,) = struct.unpack_from(order + "H", message, offset + 2)
+        end = len(message) if length == 0 and kind not in ZERO_LENGTH_SUBMESSAGES else offset + 4 + length
+        if end > len(message):
+            raise struct.error(f"a submessage runs {end - len(message)} bytes past the message's end")
+        yield kind, order, offset, end
+        offset = end
+
+
+def heartbeats(message: bytes) -> list[tuple[bytes, bytes, int, int]]:
+    """The HEARTBEATs of an RTPS message: the GUID prefix of the participant each is for (INFO_DST's; empty
+    for any), its writer's entity id, and the first and last sequence numbers the writer has; [] for a
+    message cut short."""
+    found, destination = [], b""
+    try:
+        for kind, order, start, _ in _submessages(message):
+            if kind == SUBMESSAGE_INFO_DST:
+                destination = message[start + 4:start + 4 + GUID_PREFIX_BYTES]
+            elif kind == SUBMESSAGE_HEARTBEAT:
+                first_high, first_low, last_high, last_low = struct.unpack_from(order + "iIiI", message, start + 12)
+                found.append((destination, message[start + 8:start + 12], first_high << 32 | first_low,
+                              last_high << 32 | last_low))
+    except struct.error:
+        return []
+    return found
+
+
+def data_sequence_numbers(message: bytes) -> list[tuple[bytes, int]]:
+    """The writer entity id and sequence number of each DATA (or DATA_FRAG) of an RTPS message; [] for a
+    message cut short."""
+    found = []
+    try:
+        for kind, order, start, _ in _submessages(message):
+            if kind in (SUBMESSAGE_DATA, SUBMESSAGE_DATA_FRAG):
+                high, low = struct.unpack_from(order + "iI", message, start + 16)
+                found.append((message[start + 12:start + 16], high << 32 | low))
+    except struct.error:
+        return []
+    return found
 
 
 def acknack_prompt(reader_prefix: bytes, writer_prefix: bytes, endpoints: Sequence[tuple[bytes, bytes]],
@@ -207,12 +259,34 @@ def acknack_prompt(reader_prefix: bytes, writer_prefix: bytes, endpoints: Sequen
     prefix is ``writer_prefix`` (INFO_DST): for each (reader entity id, writer entity id) of ``endpoints``,
     the ACKNACK of a reader that has nothing yet: its set of missing sequence numbers empty from 0, not
     final (as a Fast DDS reader's first, WriterProxy::perform_initial_ack_nack), numbered ``count``."""
-    info_dst = bytes([SUBMESSAGE_INFO_DST, FLAG_LITTLE_ENDIAN]) + struct.pack("<H", len(writer_prefix)) + writer_prefix
-    acknacks = b"".join(
-        bytes([SUBMESSAGE_ACKNACK, FLAG_LITTLE_ENDIAN]) + struct.pack("<H", 24) + reader + writer
-        + struct.pack("<iIII", 0, 0, 0, count)  # base 0 (high, low), no bits, the count
-        for reader, writer in endpoints)
-    return b"RTPS" + PROTOCOL_VERSION + VENDOR_UNKNOWN + reader_prefix + info_dst + acknacks
+    return _to(reader_prefix, writer_prefix, b"".join(_acknack(reader, writer, 0, 0, count)
+                                                       for reader, writer in endpoints))
+
+
+def acknack_request(reader_prefix: bytes, writer_prefix: bytes, reader: bytes, writer: bytes, first: int, last: int,
+                    count: int) -> bytes:
+    """The ACKNACK, numbered ``count``, of the reader ``reader_prefix``/``reader`` that asks the writer
+    ``writer_prefix``/``writer`` for its sequence numbers ``first`` to ``last`` (at most MAX_REQUESTED
+    of them), having every one before ``first``; with ``last`` below ``first``, one that has every
+    sequence number before ``first`` and asks for none."""
+    bits = max(0, min(last - first + 1, MAX_REQUESTED))
+    return _to(reader_prefix, writer_prefix, _acknack(reader, writer, first, bits, count))
+
+
+def _to(sender_prefix: bytes, receiver_prefix: bytes, submessages: bytes) -> bytes:
+    """An RTPS message of ``submessages`` from the participant ``sender_prefix`` for ``receiver_prefix``."""
+    info_dst = bytes([SUBMESSAGE_INFO_DST, FLAG_LITTLE_ENDIAN]) + struct.pack("<H", len(receiver_prefix))
+    return b"RTPS" + PROTOCOL_VERSION + VENDOR_UNKNOWN + sender_prefix + info_dst + receiver_prefix + submessages
+
+
+def _acknack(reader: bytes, writer: bytes, base: int, bits: int, count: int) -> bytes:
+    """An ACKNACK submessage: sequence numbers ``base`` to ``base + bits - 1`` missing, every one below
+    ``base`` received (the set's bitmap: most significant bit first, in 32-bit words)."""
+    words = [0] * ((bits + 31) // 32)
+    for bit in range(bits):
+        words[bit // 32] |= 1 << (31 - bit % 32)
+    body = reader + writer + struct.pack(f"<iII{len(words)}II", base >> 32, base & 0xFFFFFFFF, bits, *words, count)
+    return bytes([SUBMESSAGE_ACKNACK, FLAG_LITTLE_ENDIAN]) + struct.pack("<H", len(body)) + body
 
 
 def is_builtin(entity_id: bytes) -> bool:

@@ -6,6 +6,7 @@ queries on the suite's middleware and in a domain where Fast DDS and Cyclone DDS
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import socket
@@ -37,13 +38,17 @@ from roc.ros.discovery import (
     own_socket_inodes,
     writers_to_prompt,
 )
+from roc.ros.endpoint_fetch import PASS_ON_TIMES, EndpointFetch
 from roc.ros.spdp import (
     PID_DEFAULT_UNICAST_LOCATOR,
     SEDP_PUBLICATIONS,
     SEDP_SUBSCRIPTIONS,
     SPDP_WRITER,
     acknack_prompt,
+    acknack_request,
     announced_locators,
+    data_sequence_numbers,
+    heartbeats,
     is_builtin,
     stand_in_announcement,
     undirected,
@@ -196,7 +201,8 @@ def test_the_other_processes_participants_are_asked_to_announce_themselves_to_ou
 def test_the_probe_hears_the_guid_prefix_of_each_participant_of_this_host_that_answers(tmp_path: Path) -> None:
     """Domain 202, above the tests' domains: a socket standing in for another process's participant gets
     the stand-in's announcement, whose locator is the probe's, and answers there as any participant
-    does; the probe names it by the GUID prefix of the answer's RTPS header."""
+    does; the probe names it by the GUID prefix of the answer's RTPS header. A message that holds no
+    announcement is no answer."""
     [theirs] = _bound_at_free_participant_ports(202, 1)
     table = tmp_path / "udp"
     port = theirs.getsockname()[1]
@@ -210,9 +216,11 @@ def test_the_probe_hears_the_guid_prefix_of_each_participant_of_this_host_that_a
         asked = theirs.recv(65536)
         at = asked.index(struct.pack("<HH", 0x0032, 24)) + 4  # PID_METATRAFFIC_UNICAST_LOCATOR
         probe_port, probe_address = struct.unpack("<I", asked[at + 4:at + 8])[0], socket.inet_ntoa(asked[at + 20:at + 24])
-        answer = b"RTPS\x02\x03\x01\x10" + bytes.fromhex(CYCLONE_PREFIX) + bytes(8)
-        theirs.sendto(answer, (probe_address, probe_port))
-        theirs.sendto(b"not RTPS at all", (probe_address, probe_port))
+        announcement = _submessage(0x15, SPDP_WRITER.join([bytes(8), bytes(40)]))  # a DATA of its announcer
+        answer = b"RTPS\x02\x03\x01\x10" + bytes.fromhex(CYCLONE_PREFIX) + announcement
+        not_an_answer = b"RTPS\x02\x03\x01\x0f" + bytes.fromhex(FAST_DDS_PREFIX) + _heartbeat(SEDP_PUBLICATIONS[1], 1, 2)
+        for message in (not_an_answer, answer, b"not RTPS at all"):
+            theirs.sendto(message, (probe_address, probe_port))
         for _ in range(100):
             if probe.heard():
                 break
@@ -278,6 +286,68 @@ def test_the_probe_passes_an_answer_directed_to_the_stand_in_on_undirected_to_th
         probe.close()
         ours.close()
         theirs.close()
+
+
+def _heartbeat(writer: bytes, first: int, last: int, count: int = 1) -> bytes:
+    return _submessage(0x07, bytes(4) + writer + struct.pack("<iIiII", 0, first, 0, last, count))
+
+
+def _data(writer: bytes, number: int, payload: bytes = bytes(8)) -> bytes:
+    return _submessage(0x15, struct.pack("<HH", 0, 16) + bytes(4) + writer + struct.pack("<iI", 0, number) + payload)
+
+
+def test_heartbeats_and_data_are_read_with_whom_they_are_for() -> None:
+    stand_in, writer = bytes(range(12)), SEDP_PUBLICATIONS[1]
+    message = b"RTPS\x02\x03\x01\x0f" + bytes.fromhex(FAST_DDS_PREFIX) + _submessage(0x0E, stand_in) \
+        + _data(writer, 4) + _heartbeat(writer, 1, 5)
+    assert heartbeats(message) == [(stand_in, writer, 1, 5)]
+    assert data_sequence_numbers(message) == [(writer, 4)]
+    assert heartbeats(message[:-4]) == []  # cut short
+    undirected_heartbeat = b"RTPS\x02\x03\x01\x0f" + bytes.fromhex(FAST_DDS_PREFIX) + _heartbeat(writer, 2, 3)
+    assert heartbeats(undirected_heartbeat) == [(b"", writer, 2, 3)]
+
+
+def test_an_acknack_request_asks_for_each_sequence_number_of_a_range_or_for_none() -> None:
+    reader, writer = SEDP_PUBLICATIONS
+    message = acknack_request(bytes(12), bytes(range(12)), reader, writer, 3, 36, 7)
+    acknack = message[36:]  # after the header (20) and INFO_DST (16)
+    assert acknack[:4] == struct.pack("<BBH", 0x06, 0x01, len(acknack) - 4)
+    assert acknack[4:12] == reader + writer
+    base_high, base_low, bits, first_word, second_word, count = struct.unpack_from("<iIIIII", acknack, 12)
+    assert (base_high << 32 | base_low, bits, count) == (3, 34, 7)
+    assert (first_word, second_word) == (0xFFFFFFFF, 0xC0000000)  # 34 bits, the first one the highest
+    none = acknack_request(bytes(12), bytes(range(12)), reader, writer, 6, 5, 8)[36:]
+    assert struct.unpack_from("<iIII", none, 12) == (0, 6, 0, 8)  # everything before 6, nothing asked
+
+
+def test_a_fetch_asks_each_writer_for_what_it_lacks_once_it_knows_where_and_passes_each_message_on_a_few_times(
+        ) -> None:
+    fetch, stand_in, writer = EndpointFetch(), bytes(range(12)), SEDP_SUBSCRIPTIONS[1]
+    fetch.stand_ins.add(stand_in)
+    participant, at = bytes.fromhex(FAST_DDS_PREFIX), ("127.0.0.1", 7412)
+    header = b"RTPS\x02\x03\x01\x0f" + participant
+    to_stand_in = _submessage(0x0E, stand_in)
+    assert fetch.take(participant, header + to_stand_in + _heartbeat(writer, 1, 3), []) == []  # not where yet
+    [(request, address)] = fetch.take(participant, header, [at])
+    assert (request, address) == (acknack_request(stand_in, participant, SEDP_SUBSCRIPTIONS[0], writer, 1, 3, 1), at)
+    brought = header + to_stand_in + _data(writer, 2)
+    assert fetch.take(participant, brought, [at]) == []
+    [(request, _)] = fetch.take(participant, header + to_stand_in + _heartbeat(writer, 1, 3), [at])
+    assert request == acknack_request(stand_in, participant, SEDP_SUBSCRIPTIONS[0], writer, 1, 3, 2)  # 1 and 3 missing
+    for number in (1, 3):
+        fetch.take(participant, header + to_stand_in + _data(writer, number), [at])
+    [(request, _)] = fetch.take(participant, header + to_stand_in + _heartbeat(writer, 1, 3), [at])
+    assert request == acknack_request(stand_in, participant, SEDP_SUBSCRIPTIONS[0], writer, 4, 3, 3)  # all there
+    other = bytes(range(1, 13))  # a HEARTBEAT for another participant's reader is not answered
+    assert fetch.take(participant, header + _submessage(0x0E, other) + _heartbeat(writer, 1, 3), [at]) == []
+    cyclone = bytes.fromhex(CYCLONE_PREFIX)  # its writers answer at once: acknowledged, nothing kept
+    from_cyclone = b"RTPS\x02\x01\x01\x10" + cyclone + to_stand_in + _data(writer, 1) + _heartbeat(writer, 1, 2)
+    [(request, _)] = fetch.take(cyclone, from_cyclone, [at])
+    assert request == acknack_request(stand_in, cyclone, SEDP_SUBSCRIPTIONS[0], writer, 3, 2, 1)
+    passed = [fetch.to_pass_on() for _ in range(PASS_ON_TIMES + 1)]
+    assert all(len(messages) == 3 for messages in passed[:-1]) and passed[-1] == []
+    assert undirected(brought) in passed[0]  # without the INFO_DST that named the stand-in
+    assert fetch.asked_all(1) and not fetch.asked_all(2)  # two writers asked: as many as one participant has
 
 
 def _announcement(prefix: bytes, metatraffic: tuple[str, int], default: tuple[str, int]) -> bytes:
@@ -426,6 +496,46 @@ def test_a_fast_dds_participant_asked_announces_itself_to_the_stand_in_s_port(tm
         assert process_bits(answer[8:20]) == node.pid & 0xFFFF  # the header's GUID prefix: the node's participant
         assert SPDP_WRITER in answer  # a DATA(p) of its announcement writer
     finally:
+        stop_all([node])
+
+
+@pytest.mark.slow  # a node of its own (the quick loop stays under 45 s)
+def test_a_fetching_probe_gets_a_real_participant_s_endpoints_and_passes_them_on_whole(tmp_path: Path) -> None:
+    """The suite's middleware offers the fetching stand-in its endpoints, and sends their announcements
+    when asked; the probe passes each message on, whole and undirected, to this process's participant
+    (sockets of this process at a participant's two ports)."""
+    env = graph_env(SLOT, tmp_path)
+    [node] = start_nodes([{"name": "talker", "publishers": [{"topic": "chatter", "type": "std_msgs/msg/String"}]}], env)
+    domain = int(env["ROS_DOMAIN_ID"])
+    ours = []
+    for participant in range(100, 120):  # ids no participant of the node takes: it takes the lowest free one
+        port = 7400 + 250 * domain + 10 + 2 * participant
+        try:
+            ours = [socket.socket(socket.AF_INET, socket.SOCK_DGRAM) for _ in range(2)]
+            for offset, sock in enumerate(ours):
+                sock.bind(("127.0.0.1", port + offset))
+            break
+        except OSError:
+            for sock in ours:
+                sock.close()
+    probe = LocalParticipantProbe(domain, fetches_endpoints=True)
+    try:
+        assert probe.ask() == 1
+        ours[0].settimeout(0.05)
+        received: list[bytes] = []
+        deadline = time.monotonic() + 20
+        while not any(b"rt/chatter" in message for message in received) and time.monotonic() < deadline:
+            probe.pass_on_endpoints()
+            with contextlib.suppress(socket.timeout):
+                received.append(ours[0].recv(65536))
+        [announcement] = [message for message in received if b"rt/chatter" in message]
+        assert announcement[8:20] in probe.heard()  # from the node's participant, as its writer sent it
+        assert undirected(announcement) is None  # for whoever takes it
+        assert (SEDP_PUBLICATIONS[1], 1) <= max(data_sequence_numbers(announcement))
+    finally:
+        probe.close()
+        for sock in ours:
+            sock.close()
         stop_all([node])
 
 

@@ -20,7 +20,11 @@ Its own first ACKNACK to each writer then (q_xevent.c: make_preemptive_acknack, 
 1, count 0) makes a Fast DDS writer send nothing, so it heard a Fast DDS participant's endpoints only at
 that writer's next periodic HEARTBEAT (Fast DDS's endpoint discovery: every second) and its
 ``ros_discovery_info`` at that writer's (every 3 s): a first query beside Fast DDS processes took 2.2 to
-3.4 s. roc prompts those writers instead (roc.ros.graph, roc.ros.vendors.fastdds).
+3.4 s. roc prompts those writers instead (roc.ros.graph, roc.ros.vendors.fastdds). Fast DDS's writers of
+endpoint announcements then answer the participant's request 0.1 s after it comes (EDPSimple's
+``edp_nack_response_delay``), where Cyclone's own answer at once: a query fetches those announcements
+before its participant exists, while rclpy loads, and passes them on to it
+(roc.ros.discovery.early_probe).
 
 A service request from a Cyclone client can crash a Fast DDS server of Jazzy (rmw_fastrtps 8.4.3 reads the
 request's header as a sequence length and allocates gigabytes: ros2/rmw_cyclonedds#577), so roc on Cyclone

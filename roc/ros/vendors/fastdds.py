@@ -19,7 +19,13 @@ DDS reader that lost its first HEARTBEATs (roc.ros.vendors.cyclonedds) with the 
 (``prompt_count``): always taken, and the next one expected wraps to 0, so every ACKNACK the reader sends
 later is taken too (the reader's own count goes on from 1). The writer takes an ACKNACK on the port it
 listens on for that endpoint: the discovery (metatraffic) port for discovery's endpoints, the default one
-for the others (roc.ros.discovery.LocalParticipantProbe.prompt)."""
+for the others (roc.ros.discovery.LocalParticipantProbe.prompt).
+
+Its writers of endpoint announcements answer a reader's request 0.1 s after it comes (EDPSimple's
+``edp_nack_response_delay``, a constant of 2.14 and 3.x; measured: 100 to 102 ms from the request to
+the data, for each of three processes), and a fresh participant asks only once it has heard them: a
+first query waited for it (``answers_endpoint_requests_late``). roc asks them before its participant
+exists (roc.ros.discovery.early_probe)."""
 
 from __future__ import annotations
 
@@ -33,7 +39,7 @@ from roc.ros.vendors.vendor import Vendor
 
 VENDOR = Vendor("Fast DDS", vendor_id=b"\x01\x0f", middlewares=("rmw_fastrtps_cpp", "rmw_fastrtps_dynamic_cpp"),
                 late_answer_seconds=3.0,  # its default period of a participant's announcements
-                prompt_count=0xFFFFFFFF)
+                answers_endpoint_requests_late=True, prompt_count=0xFFFFFFFF)
 
 
 def process_bits(prefix: bytes) -> int | None:

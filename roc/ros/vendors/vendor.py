@@ -20,6 +20,9 @@ class Vendor:
     # participant's announcement, and its own first ACKNACK does not make every vendor's writer send
     # another: roc prompts the writers of the participants it has not wholly heard yet (roc.ros.graph)
     loses_early_heartbeats: bool = False
+    # its writers of endpoint announcements answer a reader's request late (Fast DDS: 0.1 s), so roc fetches
+    # their announcements before its participant exists (roc.ros.discovery.early_probe)
+    answers_endpoint_requests_late: bool = False
     # the count of an ACKNACK (roc.ros.spdp.acknack_prompt) that makes a writer of this vendor send a
     # HEARTBEAT at once and still take every later ACKNACK of that reader; None: roc prompts none
     prompt_count: int | None = None
