@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from roc.ros import vendors
 from roc.ros.spdp import (
+    MAX_REQUESTED,
     SEDP_PUBLICATIONS,
     SEDP_SUBSCRIPTIONS,
     acknack_request,
@@ -51,12 +52,14 @@ class EndpointFetch:
         for key in [key for key in self._unanswered if key[1] == prefix and locators]:
             (first, last), (stand_in, _, writer) = self._unanswered.pop(key), key
             have = self._fetched.get((prefix, writer), {})
-            missing = [number for number in range(first, last + 1) if number not in have]
-            if not late or not missing or self._requests.get(key, 0) >= MAX_REQUESTS:
-                missing = [last + 1, last]  # all it has taken: a writer that answers at once is not fetched from
+            window = range(first, min(last, first + MAX_REQUESTED - 1) + 1)  # what one request can ask for
+            missing = [number for number in window if number not in have]
+            if late and missing and self._requests.get(key, 0) < MAX_REQUESTS:
+                asked = (missing[0], missing[-1])
+            else:  # all it has, acknowledged: a writer that answers at once is not fetched from
+                asked = (last + 1, last)
             self._requests[key] = count = self._requests.get(key, 0) + 1
-            reader = ENDPOINT_READERS[writer]
-            request = acknack_request(stand_in, prefix, reader, writer, missing[0], missing[-1], count)
+            request = acknack_request(stand_in, prefix, ENDPOINT_READERS[writer], writer, *asked, count)
             requests += [(request, address) for address in locators]
         return requests
 
