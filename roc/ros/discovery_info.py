@@ -20,8 +20,8 @@ from __future__ import annotations
 import ctypes
 import functools
 
+from roc.cdr_reader import Reader
 from roc.errors import RocError
-from roc.ros.cdr_reader import Reader
 from roc.ros.discovery import DISCOVERY_TOPIC, Told, participant_prefix
 from roc.ros.native import (
     GID_SIZE,

@@ -15,8 +15,8 @@ from rich.color import Color
 from rich.style import Style
 from rich.text import Text
 
+from roc.cdr_reader import Reader
 from roc.errors import RocError
-from roc.ros.cdr_reader import Reader
 
 IMAGE, COMPRESSED = "sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage"
 TYPES = (IMAGE, COMPRESSED)

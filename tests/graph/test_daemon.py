@@ -97,17 +97,6 @@ def test_without_a_daemon_a_verb_answers_in_its_process_and_leaves_a_daemon_for_
     assert roc("node", "list", env=talker).stdout == "/talker\n"  # the daemon's answer now
 
 
-def test_the_daemon_answers_without_loading_numpy(talker):
-    """The daemon's answers to graph queries need no numpy (0.1 s of its start: tests/cli/test_start_up.py
-    checks the same of a query without the daemon, module by module); numpy's compiled core would be in
-    its memory map, beside the type support of its ros_discovery_info reader."""
-    for _ in range(2):  # the first query answers in its own process while the daemon starts
-        assert "/chatter" in roc("topic", "list", env=talker).stdout.splitlines()
-    mapped = Path(f"/proc/{status(talker)['pid']}/maps").read_text()
-    assert "rmw_dds_common_s__rosidl_typesupport_c" in mapped
-    assert "_multiarray_umath" not in mapped
-
-
 def test_the_daemon_is_out_of_the_terminal_s_reach_but_in_its_session(talker):
     """Its own process group: the terminal's Ctrl+C goes to the foreground group only; hang-up is
     ignored. The caller's session: a session of its own is a scheduling group of its own on Linux,

@@ -26,6 +26,8 @@ from roc.middleware import process_environment
 from roc.ros import vendors
 from roc.ros.discovery import (
     INPUT_BUFFER_BYTES,
+    PASS_ON_TIMES,
+    EndpointFetch,
     LocalParticipantProbe,
     Told,
     ask_local_participants_to_announce,
@@ -38,7 +40,6 @@ from roc.ros.discovery import (
     own_socket_inodes,
     writers_to_prompt,
 )
-from roc.ros.endpoint_fetch import PASS_ON_TIMES, EndpointFetch
 from roc.ros.spdp import (
     PID_DEFAULT_UNICAST_LOCATOR,
     SEDP_PUBLICATIONS,

@@ -184,6 +184,9 @@ class FakeProbe:
     def ask(self) -> int:
         return 0
 
+    def pass_on_endpoints(self) -> int:
+        return 0
+
     def close(self) -> None:
         pass
 
