@@ -150,7 +150,7 @@ class Cluster:
 
     def task_limit(self, local: int) -> int | Callable[[], int]:
         """The engine's limit of tasks at once (roc.engine.executor.execute's ``workers``): what the fitting
-        workers build at once (one while there are none: it waits for the first), and the tasks working
+        workers build at once (two while they build one or none: see ``limit``), and the tasks working
         on the client (``here``), at most ``local`` of those (--parallel-workers; 0: no limit). Dask gives
         a task to a worker as it is submitted, so a task submitted beyond the workers' slots waits in one
         worker's queue: a package of the longest chain, ready a moment later, waited there behind a long
@@ -160,8 +160,11 @@ class Cluster:
         return local if not local else lambda: self.limit(local)
 
     def limit(self, local: int) -> int:
-        """``task_limit``'s value now."""
-        return max(1, self.capacity()) + min(self._here, local)
+        """``task_limit``'s value now. A cluster of one build slot gets its next package ahead, waiting on
+        that worker while a result travels (there is no other worker it could wait behind): 1.25x of a
+        local build without it, 1.14x with it (cluster_bench.py, 100 packages)."""
+        slots = self.capacity()
+        return (2 if slots <= 1 else slots) + min(self._here, local)
 
     @contextlib.contextmanager
     def here(self) -> Iterator[None]:

@@ -152,9 +152,10 @@ def test_the_limit_may_change_while_running():
 def test_the_cluster_gets_as_many_packages_at_once_as_its_workers_build(monkeypatch):
     """Dask gives a task to a worker as it is submitted, so one beyond the workers' slots would wait in a
     worker's queue, where a package of the longest chain ready later waited behind a long build while
-    the other worker was free: the engine's limit is the fitting workers' slots (one while there are
-    none), and besides them the tasks working on the client, at most --parallel-workers of those. No
-    scheduler here: Cluster's arithmetic on the workers it is told of."""
+    the other worker was free: the engine's limit is the fitting workers' slots (two while there is one
+    or none: nothing can wait behind another worker), and besides them the tasks working on the
+    client, at most --parallel-workers of those. No scheduler here: Cluster's arithmetic on the
+    workers it is told of."""
     from roc.cluster.client import Cluster
 
     cluster = Cluster.__new__(Cluster)
@@ -162,7 +163,7 @@ def test_the_cluster_gets_as_many_packages_at_once_as_its_workers_build(monkeypa
     cluster._here, cluster._here_lock = 0, threading.Lock()
     workers: dict[str, float] = {}
     monkeypatch.setattr(cluster, "fitting", lambda: workers)
-    assert cluster.limit(8) == 1  # no worker yet: one task waits for the first
+    assert cluster.limit(8) == 2  # no worker yet (or one slot): the next package waits ahead
     workers.update({"worker-0": 1.0, "worker-1": 2.0})
     cluster._asked = -1.0  # ask the scheduler again
     assert cluster.limit(8) == 3
