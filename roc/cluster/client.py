@@ -161,8 +161,7 @@ class Cluster:
 
     def limit(self, local: int) -> int:
         """``task_limit``'s value now. A cluster of one build slot gets its next package ahead, waiting on
-        that worker while a result travels (there is no other worker it could wait behind): 1.25x of a
-        local build without it, 1.14x with it (cluster_bench.py, 100 packages)."""
+        that worker while a result travels: there is no other worker it could wait behind."""
         slots = self.capacity()
         return (2 if slots <= 1 else slots) + min(self._here, local)
 
