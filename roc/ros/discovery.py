@@ -314,13 +314,10 @@ class LocalParticipantProbe:
 
     def pass_on_endpoints(self) -> int:
         """Send this process's participants the endpoint announcements fetched so far, each a few times
-        (PASS_ON_TIMES: one that comes before a participant has taken in its
-        writer's participant is dropped); returns how many messages went."""
+        (PASS_ON_TIMES: one that comes before a participant has taken in its writer's participant is
+        dropped); returns how many messages went. The last ``ask`` found those participants."""
         if self._fetcher is None:
             return 0
-        if not self._ours:  # asked before this process had a participant
-            with contextlib.suppress(OSError, IndexError, ValueError):
-                self._ours = _peer_addresses(metatraffic_sockets(self.domain_id, self.tables), own=True)
         self.announced()  # what came meanwhile
         messages = self._fetcher.to_pass_on() if self._ours else []
         for message in messages:

@@ -137,18 +137,14 @@ def _announced_parameters(message: bytes) -> Iterator[tuple[int, int, str]]:
     """Each parameter of the participant announcement (the SPDP writer's DATA) in an RTPS message: its id,
     where its value starts and the byte order of the list ("<" or ">"); none when the message holds no
     announcement. Raises struct.error or IndexError on a message cut short."""
-    offset = 20  # after the RTPS header
     if not message.startswith(b"RTPS"):
         return
-    while offset + 4 <= len(message):
-        kind, flags = message[offset], message[offset + 1]
-        order = "<" if flags & FLAG_LITTLE_ENDIAN else ">"
-        (length,) = struct.unpack_from(order + "H", message, offset + 2)
-        body, offset = offset + 4, (len(message) if length == 0 else offset + 4 + length)
+    for kind, order, start, _ in _submessages(message):
+        body = start + 4
         if kind == SUBMESSAGE_DATA and message[body + 8:body + 12] == SPDP_WRITER:
             (to_inline_qos,) = struct.unpack_from(order + "H", message, body + 2)
             payload = body + 4 + to_inline_qos
-            if flags & FLAG_INLINE_QOS:
+            if message[start + 1] & FLAG_INLINE_QOS:
                 payload = _parameters_end(message, payload, order)
             yield from _parameters(message, payload)
             return
