@@ -35,4 +35,8 @@ def dask_setup(worker, roc_root: str | None) -> None:
     for name in (BUILD_RESOURCE, resource_name(digest)):
         state.total_resources[name] = slots
         state.available_resources[name] = slots
+    # Dask samples the worker's threads every 10 ms for its dashboard's profile: a build's threads only
+    # wait on their commands, and the sampling made a one-worker build of 100 packages 2 to 6 % slower.
+    for callback in ("profile", "profile-cycle"):
+        worker.periodic_callbacks.pop(callback, None)
     logger.info("roc: building in %s, %g package(s) at once, toolchain %s", root, slots, digest)

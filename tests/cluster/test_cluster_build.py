@@ -139,6 +139,16 @@ def test_diamond_builds_on_both_workers_and_the_client_runs_no_build_tool(built,
         assert list((root / "slots").glob("*/install/dia_a/lib/libdia_a.so")), root
 
 
+def test_workers_started_either_way_do_not_profile_their_threads(servers):
+    import distributed
+
+    with distributed.Client(servers[0], timeout=30, set_as_default=False) as client:
+        callbacks = client.run(lambda dask_worker: sorted(dask_worker.periodic_callbacks))
+    assert len(callbacks) == 2, callbacks
+    for names in callbacks.values():
+        assert "heartbeat" in names and "profile" not in names and "profile-cycle" not in names, names
+
+
 def test_install_tree_equals_a_local_build_and_its_programs_run(built, tmp_path):
     ws, _, _ = built
     local = _checkout(tmp_path, "local")
