@@ -169,8 +169,8 @@ class McapFile:
             return
         try:
             for _, channel, record in self._reader.iter_messages(
-                    topics=list(wanted) if wanted is not None else None, start_time=start,
-                    end_time=end + 1 if end is not None else None, log_time_order=True):
+                    topics=list(wanted) if wanted is not None else None, starting_at=start, ending_at=end,
+                    log_time_order=True):
                 yield Message(channel.topic, record.data, record.log_time, record.publish_time)
         except READ_ERRORS as error:
             raise BagError(f"{self.path}: damaged MCAP data ({type(error).__name__}: {error})") from None
