@@ -107,7 +107,9 @@ def pack(archive: Path, name: str, places: Places, merged: bool) -> None:
     temporary = archive.with_name(f".{archive.name}.{os.getpid()}.tmp")
     build_dir = places.build_base / name
     try:
-        with tarfile.open(temporary, "w:gz") as tar:
+        # gzip's own default level: tarfile's 9 took 3 to 4 times as long (rclcpp's install: 0.58 s
+        # against 0.18 s) for an archive 0 to 4 % smaller, on every package a build uploads
+        with tarfile.open(temporary, "w:gz", compresslevel=6) as tar:
             for path in installed_files(name, places, merged):
                 tar.add(path, arcname=f"install/{path.relative_to(places.install_base)}", recursive=False)
             for state in STATE_FILES:

@@ -300,3 +300,18 @@ def test_byte_code_is_compiled_again_for_the_place_it_is_restored_at(tmp_path) -
         assert data[:4] == importlib.util.MAGIC_NUMBER and int.from_bytes(data[4:8], "little") == flag
         assert marshal.loads(data[16:]).co_filename == str(restored / "mod.py")
     assert sys.implementation.cache_tag in Path(next(iter(caches))).name
+
+
+def test_an_archive_is_packed_at_gzips_default_level_not_its_slowest(tmp_path) -> None:
+    """tarfile's level 9 took 3 to 4 times as long as gzip's default 6 for the same size (rclcpp)."""
+    from roc.builder.artefact import pack
+
+    built = Places(tmp_path, tmp_path / "build", tmp_path / "install")
+    (built.install_base / "pkg" / "share").mkdir(parents=True)
+    (built.install_base / "pkg" / "share" / "data.txt").write_text("some data\n" * 1000)
+    archive = tmp_path / "pkg.tar.gz"
+    pack(archive, "pkg", built, merged=False)
+    header = archive.read_bytes()[:10]
+    assert header[:3] == b"\x1f\x8b\x08" and header[8] == 0, header  # XFL: 2 is level 9, 4 is level 1
+    with tarfile.open(archive) as tar:
+        assert tar.getnames() == ["install/pkg/share/data.txt"]
