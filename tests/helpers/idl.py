@@ -34,3 +34,21 @@ def check_msg_with_rosidl_parser(root: Path, relative: str, tmp: Path):
     with contextlib.redirect_stdout(io.StringIO()):
         idl = convert_msg_to_idl(root / package, package, Path(relative).relative_to(package), tmp)
     return parse_idl_file(IdlLocator(tmp, idl.name))
+
+
+# A program run in a sourced workspace of workspaces/fixtures/idl: the protobuf and ROS messages the
+# package generated, converted both ways by its installed conversion module and used by its dependent.
+CONVERT = """
+from robot import state_pb2
+from robot_proto_msgs.msg import State
+from robot_proto_msgs_protobuf import to_proto, to_ros  # installed with the package
+from robot_proto_tools import pose_fields  # the dependent package
+pb = state_pb2.State(mode=1, waypoint="dock", frames=[b"jpg"])
+pb.pose.x, pb.pose.theta = 1.0, 0.5
+pb.stamp.seconds = 42
+pb.sensors["lidar"] = 0.25
+ros = to_ros(pb, State)
+assert ros.goal_case == State.GOAL_WAYPOINT and ros.mode == State.MODE_DRIVING and ros.stamp.sec == 42
+assert to_proto(ros, state_pb2.State) == pb
+print(" ".join(pose_fields()))
+"""

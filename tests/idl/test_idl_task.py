@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 from helpers.build import FIXTURES, in_sourced_shell, roc
+from helpers.idl import CONVERT
 
 from roc.engine.events import TaskOutput
 from roc.engine.process import TaskContext, TaskError
@@ -92,22 +93,6 @@ def test_bad_proto_fails_with_its_file_and_line_and_is_never_up_to_date(tmp_path
     output = _run(generation)
     assert output.splitlines() == ["code generation failed", f'roc: error: {source / TYPES}:6:16: Expected ";".']
     assert generation.check() == ["its last code generation did not succeed"]
-
-
-CONVERT = """
-from robot import state_pb2
-from robot_proto_msgs.msg import State
-from robot_proto_msgs_protobuf import to_proto, to_ros  # installed with the package
-from robot_proto_tools import pose_fields  # the dependent package
-pb = state_pb2.State(mode=1, waypoint="dock", frames=[b"jpg"])
-pb.pose.x, pb.pose.theta = 1.0, 0.5
-pb.stamp.seconds = 42
-pb.sensors["lidar"] = 0.25
-ros = to_ros(pb, State)
-assert ros.goal_case == State.GOAL_WAYPOINT and ros.mode == State.MODE_DRIVING and ros.stamp.sec == 42
-assert to_proto(ros, state_pb2.State) == pb
-print(" ".join(pose_fields()))
-"""
 
 
 def _events(workspace: Path) -> list[dict]:

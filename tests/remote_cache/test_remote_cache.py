@@ -15,6 +15,7 @@ import threading
 
 import pytest
 from helpers.build import FIXTURES, in_sourced_shell, roc, ros_env, without_suite_compiler_cache
+from helpers.idl import CONVERT
 from helpers.remote_servers import free_port, s3, silent_server, webdav
 
 pytestmark = pytest.mark.slow
@@ -269,8 +270,6 @@ def test_s3_store(tmp_path):
 def test_generated_interface_package_restored_elsewhere_runs(dav, tmp_path):
     """A package with an idl task (protobuf sources): rosidl's generated code travels, and the
     conversion code its dependent uses runs at the new path."""
-    from test_idl_task import CONVERT
-
     url, _, env = dav
     ci, dev = tmp_path / "ci", tmp_path / "elsewhere" / "dev"
     for ws in (ci, dev):
