@@ -28,3 +28,9 @@ def test_lost_messages_are_unknown_on_topics_without_sequence_numbers() -> None:
 def test_lost_messages_are_counted_from_sequence_numbers() -> None:
     lines = _summary(result({"/a": TopicStats(received=5, written=5, lost=0)}), "run")
     assert lines[-1] == "Lost messages: 0 (gaps in the publishers' sequence numbers)"
+
+
+def test_topics_are_listed_by_name_whatever_order_they_were_discovered_in() -> None:
+    lines = _summary(result({"/tf_static": TopicStats(received=1, written=1),
+                             "/tf": TopicStats(received=9, written=9)}), "run")
+    assert [line.split()[0] for line in lines[1:4]] == ["topic", "/tf", "/tf_static"], lines

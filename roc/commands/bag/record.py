@@ -123,8 +123,9 @@ def _summary(result, uri: str) -> list[str]:
     lines = [f"Recorded {plural(metadata.message_count, 'message')} on {plural(len(metadata.topics), 'topic')} "
              f"into {uri} ({plural(len(metadata.relative_file_paths), 'file')})"]
     if result.stats:
-        lines += table_lines([[name, s.received, s.written, "unknown" if s.unsequenced else s.lost]
-                              for name, s in result.stats.items()], header=["topic", "received", "written", "lost"])
+        rows = [[name, s.received, s.written, "unknown" if s.unsequenced else s.lost]
+                for name, s in sorted(result.stats.items())]  # by name: topics are subscribed as discovered
+        lines += table_lines(rows, header=["topic", "received", "written", "lost"])
     lost = sum(s.lost for s in result.stats.values())
     unknown = sum(1 for s in result.stats.values() if s.unsequenced)
     if unknown:
