@@ -267,12 +267,18 @@ def _before(graph: dict[str, set[str]], jobs: dict[str, list[Job]]) -> dict[Job,
     return {job: job.after or [jobs[d][-1] for d in graph[name]] for name, js in jobs.items() for job in js}
 
 
+def _dependents(before: dict[Job, list[Job]]) -> dict[Job, list[Job]]:
+    """The jobs waiting for each job."""
+    dependents: dict[Job, list[Job]] = {job: [] for job in before}
+    for job, earlier_jobs in before.items():
+        for earlier in earlier_jobs:
+            dependents[earlier].append(job)
+    return dependents
+
+
 def chains_to_end(graph: dict[str, set[str]], jobs: dict[str, list[Job]]) -> dict[Job, float]:
     """Each job's longest chain of work to the build's end, across packages."""
-    dependents: dict[Job, list[Job]] = {j: [] for js in jobs.values() for j in js}
-    for job, before in _before(graph, jobs).items():
-        for earlier in before:
-            dependents[earlier].append(job)
+    dependents = _dependents(_before(graph, jobs))
     chain: dict[Job, float] = {}
     for job in reversed(_job_order(dependents)):
         chain[job] = job.work + max((chain[d] for d in dependents[job]), default=0.0)
@@ -284,12 +290,8 @@ def lower_bound(graph: dict[str, set[str]], jobs: dict[str, list[Job]], cores: i
     each package, the soonest it can be done plus the work of the packages that wait for it (none of
     which can start before) over the cores."""
     before = _before(graph, jobs)
-    dependents: dict[Job, list[Job]] = {j: [] for j in before}
-    for job, earlier_jobs in before.items():
-        for earlier in earlier_jobs:
-            dependents[earlier].append(job)
     finish: dict[Job, float] = {}
-    for job in _job_order(dependents):
+    for job in _job_order(_dependents(before)):
         finish[job] = job.work + max((finish[b] for b in before[job]), default=0.0)
     work = {name: sum(j.work for j in js) for name, js in jobs.items()}
     waiting = {name: {n for n in graph if name in _all_dependencies(graph, n)} for name in graph}
